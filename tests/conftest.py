@@ -1,0 +1,82 @@
+"""Shared fixtures.
+
+``shared_data``: the folder ``../shared/data`` (real third-party data), or a
+skip with the reason when it is absent. The core suite never needs it.
+
+``two_room_scene``: a small hand-built scene (living room + bedroom, one
+door) with known instances, for tests that need exact expectations.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
+
+ROOT = Path(__file__).resolve().parents[1]
+SHARED_DATA = Path(os.environ.get("IGNJAX_SHARED_DATA", ROOT.parent / "shared" / "data"))
+
+
+@pytest.fixture(scope="session")
+def shared_data() -> Path:
+    if not SHARED_DATA.is_dir():
+        pytest.skip(f"third-party data folder {SHARED_DATA} is absent (set IGNJAX_SHARED_DATA to use another)")
+    return SHARED_DATA
+
+
+def make_two_room_scene():
+    """Living room [0,5]x[0,4] and bedroom [5,9]x[0,4], a 1 m door at x=5, y=2.
+
+    Instances (ids): ``bed_0`` (bedroom, against the east wall), ``table_0``
+    (living room centre), ``laptop_0`` on the table, ``chair_0``/``chair_1``
+    (living room, facing the table), ``chair_2`` (bedroom), ``painting_0``
+    (living room north wall).
+    """
+    from ignjax.scenes import catalogue as cat
+    from ignjax.scenes.model import Attributes, Door, Room, Scene, SceneMeta, Wall
+
+    rng = np.random.default_rng(0)
+    rooms = (
+        Room("room_0", "living_room", ((0, 0), (5, 0), (5, 4), (0, 4)), "Living room"),
+        Room("room_1", "bedroom", ((5, 0), (9, 0), (9, 4), (5, 4)), "Bedroom"),
+    )
+    t = 0.1
+    walls = (
+        Wall("wall_s", (0, 0), (9, 0), t, 2.5, 0, ("room_0", "room_1")),
+        Wall("wall_n", (0, 4), (9, 4), t, 2.5, 0, ("room_0", "room_1")),
+        Wall("wall_w", (0, 0), (0, 4), t, 2.5, 0, ("room_0",)),
+        Wall("wall_e", (9, 0), (9, 4), t, 2.5, 0, ("room_1",)),
+        Wall("wall_m0", (5, 0), (5, 1.5), t, 2.5, 0, ("room_0", "room_1")),
+        Wall("wall_m1", (5, 2.5), (5, 4), t, 2.5, 0, ("room_0", "room_1")),
+        Wall("wall_m_lintel", (5, 1.5), (5, 2.5), t, 0.4, 2.1, ("room_0", "room_1")),
+    )
+    doors = (Door("door_0", (5, 2), 1.0, math.pi / 2, ("room_0", "room_1")),)
+    C = cat.CATALOGUE
+    insts = []
+
+    def add(iid, cat_name, attrs, pos, yaw, room, support=None):
+        built = C[cat_name].build(attrs, rng)
+        inst = cat.instantiate(iid, cat_name, attrs, built, pos, yaw, room, support)
+        insts.append(inst)
+        return inst, built
+
+    add("bed_0", "bed", Attributes("blue", "wood", "medium", "made"), (7.9, 2.0, 0.0), math.pi, "room_1")
+    table, tb = add("table_0", "dining_table", Attributes("brown", "wood", "medium", None), (2.5, 2.0, 0.0), 0.0, "room_0")
+    top = tb.surfaces[0].height
+    add("laptop_0", "laptop", Attributes("gray", "metal", "medium", "open"), (2.5, 2.0, top), 0.0, "room_0", "table_0")
+    add("chair_0", "chair", Attributes("red", "wood", "medium", None), (1.3, 2.0, 0.0), 0.0, "room_0")
+    add("chair_1", "chair", Attributes("green", "metal", "medium", None), (3.7, 2.0, 0.0), math.pi, "room_0")
+    add("chair_2", "chair", Attributes("red", "wood", "medium", None), (6.0, 0.8, 0.0), math.pi / 2, "room_1")
+    add("painting_0", "painting", Attributes("yellow", "wood", "medium", None), (2.5, 3.94, 1.2), -math.pi / 2, "room_0")
+    return Scene("two_rooms", rooms, doors, walls, tuple(insts), SceneMeta(source="tests/conftest.py", source_format="procgen"))
+
+
+@pytest.fixture(scope="session")
+def two_room_scene():
+    return make_two_room_scene()
