@@ -8,4 +8,12 @@ procedural houses, compilation to MuJoCo/MJX, navigation grids), ``episodes``
 ``ignjax.evaluate``, ``ignjax.sweep`` and ``ignjax.bench``.
 """
 
+import os as _os
+
+# Headless rendering by default: MuJoCo reads MUJOCO_GL when it is first
+# imported, so it is set here, before any ignjax module imports mujoco. A
+# value the user set (glfw, osmesa, egl) is kept.
+_os.environ.setdefault("MUJOCO_GL", "egl")
+_os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa" if _os.environ["MUJOCO_GL"] == "osmesa" else "egl")
+
 __version__ = "0.1.0"

@@ -73,7 +73,10 @@ def make_two_room_scene():
     add("chair_0", "chair", Attributes("red", "wood", "medium", None), (1.3, 2.0, 0.0), 0.0, "room_0")
     add("chair_1", "chair", Attributes("green", "metal", "medium", None), (3.7, 2.0, 0.0), math.pi, "room_0")
     add("chair_2", "chair", Attributes("red", "wood", "medium", None), (6.0, 0.8, 0.0), math.pi / 2, "room_1")
-    add("painting_0", "painting", Attributes("yellow", "wood", "medium", None), (2.5, 3.94, 1.2), -math.pi / 2, "room_0")
+    pattrs = Attributes("yellow", "wood", "medium", None)
+    hx = C["painting"].build(pattrs, rng).half_extents[0]
+    # back flush against the north wall's inner face (y = 4 - t/2), facing south into the room
+    add("painting_0", "painting", pattrs, (2.5, 4.0 - t / 2 - hx, 1.2), -math.pi / 2, "room_0")
     return Scene("two_rooms", rooms, doors, walls, tuple(insts), SceneMeta(source="tests/conftest.py", source_format="procgen"))
 
 

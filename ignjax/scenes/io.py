@@ -25,6 +25,8 @@ from ignjax.scenes.model import Scene, scene_from_dict
 USD_SUFFIXES = (".usd", ".usda", ".usdc", ".usdz")
 MESH_SUFFIXES = (".gltf", ".glb", ".obj")
 JSON_SUFFIXES = (".json", ".jsonl", ".jsonl.gz", ".json.gz")
+SIDECAR_SUFFIX = ".ignjax.json"
+"""Mesh-scene sidecars (see :mod:`ignjax.scenes.meshes`); never scenes themselves."""
 
 
 def _suffix(path: Path) -> str:
@@ -56,7 +58,7 @@ def load_scenes(path: str | os.PathLike) -> list[Scene]:
             from ignjax.scenes.manifest import read_manifest
 
             return [s for entry in read_manifest(manifest) for s in load_scenes(p / entry["file"])]
-        files = sorted(f for f in p.iterdir() if f.is_file() and is_scene_file(f))
+        files = sorted(f for f in p.iterdir() if f.is_file() and is_scene_file(f) and not f.name.endswith(SIDECAR_SUFFIX))
         if not files:
             raise SceneError(p, None, "the directory holds no USD, JSON or mesh scene files")
         return [s for f in files for s in load_scenes(f)]

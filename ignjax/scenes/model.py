@@ -384,12 +384,9 @@ class Scene:
             out[inst.category] = out.get(inst.category, 0) + 1
         return dict(sorted(out.items()))
 
-    def room_at(self, xy) -> str | None:
-        """Id of the room whose polygon contains point ``xy``, or None."""
-        for r in self.rooms:
-            if bool(r.contains(np.asarray(xy, dtype=np.float64)[None])[0]):
-                return r.id
-        return None
+    def room_at(self, xy, snap: float = 0.0) -> str | None:
+        """Id of the room containing point ``xy`` (see :func:`room_containing`)."""
+        return room_containing(self.rooms, xy, snap)
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """(lo, hi) of the scene in x, y, z over rooms, walls and instances."""
@@ -451,6 +448,33 @@ def points_in_polygon(points, poly: Sequence[Vec2]) -> np.ndarray:
         xint = x0 + (y - y0) * (x1 - x0) / (y1 - y0)
     inside = np.logical_and(cond, x < xint).sum(axis=1) % 2 == 1
     return inside.reshape(shape)
+
+
+def polygon_edge_distance(point, poly: Sequence[Vec2]) -> float:
+    """Distance from a 2-D point to the nearest edge of a polygon."""
+    p = np.asarray(point, dtype=np.float64)
+    v = np.asarray(poly, dtype=np.float64).reshape(-1, 2)
+    a, b = v, np.roll(v, -1, axis=0)
+    ab = b - a
+    t = np.clip(((p - a) * ab).sum(1) / np.maximum((ab * ab).sum(1), 1e-18), 0.0, 1.0)
+    return float(np.hypot(*(a + t[:, None] * ab - p).T).min())
+
+
+def room_containing(rooms: Sequence["Room"], xy, snap: float = 0.0) -> str | None:
+    """Id of the first room whose floor polygon contains ``xy``; failing that,
+    the room whose boundary is nearest within ``snap`` metres (for objects
+    hung on a wall line or standing on a threshold); else None."""
+    p = np.asarray(xy, dtype=np.float64)[:2]
+    for r in rooms:
+        if bool(r.contains(p[None])[0]):
+            return r.id
+    best, best_d = None, snap
+    if snap > 0:
+        for r in rooms:
+            d = polygon_edge_distance(p, r.polygon)
+            if d <= best_d:
+                best, best_d = r.id, d
+    return best
 
 
 def _segments_cross(a0, a1, b0, b1) -> bool:

@@ -253,6 +253,7 @@ _CATEGORY_ALIASES = MappingProxyType(
         "stove_burner": "stove_burner",
         "washer": "washing_machine",
         "tumble_dryer": "dryer",
+        "clothes_dryer": "dryer",
         "bath_tub": "bathtub",
         "tub": "bathtub",
         "shower_stall": "shower",

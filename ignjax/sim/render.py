@@ -6,9 +6,9 @@ y down, z forward; the agent's eye looks along heading ``yaw`` (radians,
 counter-clockwise from +X) tilted by ``pitch`` (radians, positive up).
 View ``k`` of the 8-view panorama looks along ``yaw + k * 45 degrees``.
 
-Rendering uses OpenGL through EGL when ``MUJOCO_GL=egl`` is set (headless
-Mesa on a CPU machine, the NVIDIA driver on a GPU machine); we set that
-default on import unless the user chose another backend.
+Rendering uses OpenGL through EGL (headless Mesa on a CPU machine, the
+NVIDIA driver on a GPU machine): importing :mod:`ignjax` sets
+``MUJOCO_GL=egl`` unless the user chose another backend.
 """
 
 from __future__ import annotations
@@ -16,11 +16,8 @@ from __future__ import annotations
 import math
 import os
 
-os.environ.setdefault("MUJOCO_GL", "egl")
-os.environ.setdefault("PYOPENGL_PLATFORM", os.environ["MUJOCO_GL"] if os.environ["MUJOCO_GL"] in ("egl", "osmesa") else "egl")
-
-import mujoco  # noqa: E402
-import numpy as np  # noqa: E402
+import mujoco
+import numpy as np
 
 VIEW_NAMES = ("front", "front-left", "left", "rear-left", "rear", "rear-right", "right", "front-right")
 
