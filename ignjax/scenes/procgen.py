@@ -1001,6 +1001,8 @@ class _Furnisher:
             return None
         for _ in range(tries):
             sup, k, h, corners = options[int(rng.integers(len(options)))]
+            if 2 * hz > sup.built.surfaces[k].clearance - 0.01:  # no room under the next shelf board
+                continue
             q = int(rng.integers(4)) if sup.spec.placement == "floor" else (0 if rng.random() < 0.6 else int(rng.integers(4)))
             yaw = math.atan2(math.sin(sup.inst.yaw + q * math.pi / 2), math.cos(sup.inst.yaw + q * math.pi / 2))
             ex, ey = (hx, hy) if abs(math.cos(yaw)) > 0.5 else (hy, hx)
