@@ -543,7 +543,8 @@ def test_distractor_counts_follow_instances_per_multi():
     for s in range(4):
         h = generate_house(s, p, catalogue=WIDE)
         info = house_info(h)
-        assert len(info["distractor_categories"]) == 3
+        # planned categories are reported only when placed; a full house may drop one
+        assert 2 <= len(info["distractor_categories"]) <= 3
         for c in info["distractor_categories"]:
             assert vocab.is_target_eligible(c)
             counts.append(h.categories()[c])

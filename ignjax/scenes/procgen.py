@@ -60,7 +60,9 @@ Furniture (generic over :data:`ignjax.scenes.catalogue.CATALOGUE`)
     ``passage_width`` between them (except within a group, side by side
     along one wall, or next to a flat object such as a rug, which the agent
     can walk over); and every placement is checked on a 10 cm raster of the
-    room inflated by the agent radius (0.2 m): all door cells of the room
+    room inflated by a clearance radius of 0.26 m (a 0.18 m agent plus the
+    rounding of objects to the 5 cm cells of the navigation grid, so every
+    passage this check accepts is also open on that grid): all door cells of the room
     stay connected, and every floor object stays within 0.8 m (wall objects
     1.2 m) of that connected free space. Objects that break this are
     dropped.
@@ -127,7 +129,7 @@ _MIN_SIDE = 1.5  # smallest room side, metres
 _DOOR_MARGIN = 0.2  # door edge to the end of a shared wall, metres
 _MIN_DOOR = 0.7  # narrowest door when the shared wall is short, metres
 _CELL = 0.1  # raster cell for the navigability check, metres
-_AGENT_RADIUS = 0.2
+_AGENT_RADIUS = 0.26  # 0.18 m agent + rounding of objects to 5 cm navigation-grid cells
 _REACH = 0.8  # every floor object within this distance of the room's free space
 _REACH_WALL = 1.2  # every wall object (a painting may hang above a sofa)
 _LOW_WALL_OBJECT = 1.0  # wall objects hung lower than this are obstacles
@@ -229,11 +231,11 @@ class HouseParams:
     exterior_door: bool = True
     furniture_density: float = 0.25
     max_floor_objects_per_room: int = 10
-    small_objects_per_surface: tuple[int, int] = (0, 2)
+    small_objects_per_surface: tuple[int, int] = (1, 3)
     wall_objects_per_room: tuple[int, int] = (0, 2)
-    multi_categories: int = 3
-    instances_per_multi: tuple[int, int] = (2, 4)
-    same_room_prob: float = 0.4
+    multi_categories: int = 8
+    instances_per_multi: tuple[int, int] = (4, 10)
+    same_room_prob: float = 0.5
     similar_appearance_prob: float = 0.3
     passage_width: float = 0.6
     door_clearance: float = 1.0
@@ -1222,7 +1224,8 @@ def _furnish(rooms: list[Room], rects, doors: list[Door], params: HouseParams,
 
     for k, ctx in enumerate(ctxs):
         _furnish_room(f, ctx, required[k])
-    return f.instances, multi
+    placed = {inst.category for inst in f.instances}
+    return f.instances, [m for m in multi if m in placed]  # a planned category that found no room is not reported
 
 
 def _furnish_room(f: _Furnisher, ctx: _RoomCtx, req: list[tuple[CategorySpec, Attributes]]) -> None:
