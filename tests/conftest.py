@@ -83,3 +83,36 @@ def make_two_room_scene():
 @pytest.fixture(scope="session")
 def two_room_scene():
     return make_two_room_scene()
+
+
+@pytest.fixture(scope="session")
+def small_benchmark(tmp_path_factory):
+    """A small benchmark built end to end, shared by the simulator, agent and
+    study tests: two procedural houses (3 and 5 rooms) written as USD, a
+    40-episode balanced subset written as an episode file, and the loaded
+    :class:`~ignjax.episodes.batch.EpisodeSet`."""
+    from ignjax.episodes.batch import load_benchmark
+    from ignjax.episodes.construct import BuildConfig, build_benchmark
+    from ignjax.episodes.schema import construction_path, write_records
+    from ignjax.scenes.procgen import HouseParams, generate_house
+    from ignjax.scenes.usd import save_usd
+
+    root = tmp_path_factory.mktemp("bench")
+    houses = [generate_house(11, HouseParams(n_rooms=3), "small_a"), generate_house(12, HouseParams(n_rooms=5), "small_b")]
+    for h in houses:
+        save_usd(h, root / f"{h.id}.usda")
+    built = build_benchmark([(h, f"{h.id}.usda") for h in houses], BuildConfig(subset=40, starts_per_target=2))
+    path = root / "episodes.jsonl.gz"
+    write_records(path, built["subset"])
+    write_records(construction_path(path), built["subset_construction"])
+    es = load_benchmark(path)
+    return {"root": root, "houses": houses, "built": built, "path": path, "set": es}
+
+
+@pytest.fixture(scope="session")
+def small_world(small_benchmark):
+    from ignjax.sim.env import World
+    from ignjax.sim.types import SimConfig
+
+    es = small_benchmark["set"]
+    return World(es.bank, es.fields, SimConfig())

@@ -308,6 +308,11 @@ def region_text(scene: Scene, anchors: dict[str, tuple[str, ...]], target: Insta
     """Type-2 fact: the goal room and a coarse region inside it (the largest
     nearby piece of furniture of another category), without any appearance
     detail of the target."""
+    return region_fact(scene, anchors, target)[0]
+
+
+def region_fact(scene: Scene, anchors: dict[str, tuple[str, ...]], target: Instance) -> tuple[str, str | None]:
+    """:func:`region_text` and the category of the region's anchor (or None)."""
     room_label = scene.room(target.room).label if target.room else vocab.OTHER_ROOM
     room_name = vocab.ROOM_DISPLAY[room_label]
     by_id = {i.id: i for i in scene.instances}
@@ -321,5 +326,5 @@ def region_text(scene: Scene, anchors: dict[str, tuple[str, ...]], target: Insta
     if cands:
         big = max(cands, key=lambda i: i.bbox.half_extents[0] * i.bbox.half_extents[1]) if not target.support else cands[0]
         prep = "on" if big.id == target.support else "near"
-        return f"{where}, {prep} the {vocab.category_display(big.category)}."
-    return f"{where}."
+        return f"{where}, {prep} the {vocab.category_display(big.category)}.", big.category
+    return f"{where}.", None

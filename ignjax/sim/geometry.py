@@ -48,8 +48,16 @@ def grid_to_pixel(col, row, width: float, height: float):
 
 
 def pixel_ray(K, uv):
-    """Camera-frame direction K^-1 [u, v, 1] (3,) (z component 1)."""
-    return jnp.linalg.solve(K, jnp.array([uv[0], uv[1], 1.0], dtype=jnp.float32))
+    """Camera-frame direction K^-1 [u, v, 1] (3,) (z component 1), in closed
+    form for a pinhole K without skew (the same arithmetic batched or not)."""
+    x = (uv[0] - K[0, 2]) / K[0, 0]
+    y = (uv[1] - K[1, 2]) / K[1, 1]
+    return jnp.stack([x, y, jnp.ones_like(x)])
+
+
+def matvec3(R, x):
+    """R @ x for a 3x3 matrix, as explicit sums in a fixed order."""
+    return jnp.stack([R[i, 0] * x[0] + R[i, 1] * x[1] + R[i, 2] * x[2] for i in range(3)])
 
 
 def backproject(K, uv, depth):
@@ -71,7 +79,7 @@ def view_rotation(yaw, pitch=0.0):
 
 def camera_to_world(R_wc, t_wc, x_c):
     """x_w = R_wc x_c + t_wc."""
-    return R_wc @ x_c + t_wc
+    return matvec3(R_wc, x_c) + t_wc
 
 
 def invert_extrinsic(R_cw, t_cw):
@@ -88,8 +96,8 @@ def floor_intersection(t_wc, d_w, n=(0.0, 0.0, 1.0), b=0.0):
         camera (s > 0) and the ray is not parallel to it.
     """
     n = jnp.asarray(n, jnp.float32)
-    denom = n @ d_w
-    s = -(n @ t_wc + b) / jnp.where(jnp.abs(denom) > 1e-9, denom, 1e-9)
+    denom = n[0] * d_w[0] + n[1] * d_w[1] + n[2] * d_w[2]
+    s = -(n[0] * t_wc[0] + n[1] * t_wc[1] + n[2] * t_wc[2] + b) / jnp.where(jnp.abs(denom) > 1e-9, denom, 1e-9)
     valid = (jnp.abs(denom) > 1e-9) & (s > 0)
     return t_wc + s * d_w, valid
 

@@ -1,0 +1,394 @@
+"""The built-in JAX-native agents.
+
+=================  =====  ==========  ======================================================
+name               asks   privileged  behaviour
+=================  =====  ==========  ======================================================
+``random``         no     no          random MOVEs, STOP with a small probability per step
+``shortest_path``  no     **yes**     follows the target's geodesic field; an upper bound,
+                                      never a fair competitor
+``explorer``       no     no          explores (free space, unvisited, not backwards), walks
+                                      to the nearest instance of the goal category it has
+                                      seen and stops there
+``naive_asker``    yes    no          asks freely, like the paper's unconstrained baselines:
+                                      Type 1 and 2 first, Type 4 at every plausible candidate
+                                      in front, Type 3 every third step otherwise
+``eig``            yes    no          cost-aware: keeps a belief over target hypotheses and
+                                      asks the question with the largest EIG / cost when that
+                                      ratio exceeds a threshold (Eq. 1, computed exactly)
+=================  =====  ==========  ======================================================
+
+The EIG agent's belief
+    Hypotheses are the candidate slots of :class:`~ignjax.agents.base.Memory`
+    (instances of the instruction's category seen so far, minus those a
+    Type-4 answer rejected) plus one "not seen yet" hypothesis whose prior
+    weight is ``max(prior_count - seen, 0.25)``. Each hypothesis carries the
+    log-likelihood of the answers received so far.
+
+    Answer models (likelihood of answer a under hypothesis h):
+
+    * Type 1: a = the target's colour. A seen candidate answers its observed
+      colour (uniform when unobserved); "not seen" answers uniformly over
+      the 12 colours. Once the answer is known the question is worth 0.
+    * Type 2: a = the goal room label (12 labels). A candidate answers the
+      room label the agent stood in when it saw it (uniform when unknown);
+      "not seen" answers uniformly. Worth 0 once known.
+    * Type 3: a = the sector (8) of the route's way out. A candidate answers
+      the sector of its bearing with probability 0.6 and each neighbouring
+      sector with 0.2 (routes bend); "not seen" answers uniformly.
+    * Type 4: about the most probable candidate in the front view within
+      3 m: yes under that candidate, no under every other hypothesis. Worth
+      0 when no candidate is in front.
+
+    EIG_t = H[b] - sum_a p(a) H[b | a] (nats) for each type, exactly on the
+    belief; the agent asks the type maximising EIG_t / w_t if that ratio
+    exceeds ``threshold`` and questions are left. Otherwise it moves: to
+    the most probable candidate when its posterior exceeds ``commit``
+    (stopping there when closer than ``stop_range`` with posterior at least
+    ``p_stop``), else it explores, biased toward the last route hint.
+    Because the costs w enter only through EIG / w, raising a cost lowers
+    the asking rate of that type.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from functools import partial
+from types import MappingProxyType
+
+import jax
+import jax.numpy as jnp
+
+from ignjax.agents.base import (
+    Agent, Memory, candidate_relative, explore_direction, move_toward, observe_memory,
+)
+from ignjax.metrics import LOCKED_COSTS
+from ignjax.scenes import vocab
+from ignjax.sim import types as T
+from ignjax.sim.geometry import wrap_angle
+
+N_COLORS = len(vocab.COLORS)
+N_ROOM_LABELS = len(vocab.ALL_ROOM_LABELS)
+
+
+def _pytree(cls):
+    names = [f.name for f in dataclasses.fields(cls)]
+    return partial(jax.tree_util.register_dataclass, data_fields=names, meta_fields=[])(cls)
+
+
+# ---------------------------------------------------------------------------
+# random
+# ---------------------------------------------------------------------------
+
+
+@_pytree
+@dataclass(frozen=True)
+class RandomParams:
+    """stop_prob: () probability of STOP at each decision."""
+
+    stop_prob: jax.Array
+
+
+def _random_init(params, obs, key):
+    return jnp.int32(0)
+
+
+def _random_act(params, obs, answers, pstate, key, priv):
+    k1, k2, k3, k4 = jax.random.split(key, 4)
+    stop = jax.random.uniform(k1) < params.stop_prob
+    a = T.Action.make(jnp.where(stop, T.STOP, T.MOVE), jax.random.randint(k2, (), 0, 8),
+                      jax.random.randint(k3, (), 2, 8), jax.random.randint(k4, (), 1, 4))
+    return a, pstate + 1
+
+
+RANDOM = Agent("random", _random_init, _random_act, lambda: RandomParams(jnp.float32(0.05)),
+               description="random moves, stops with probability 0.05 per step")
+
+
+# ---------------------------------------------------------------------------
+# shortest path (privileged)
+# ---------------------------------------------------------------------------
+
+
+@_pytree
+@dataclass(frozen=True)
+class PathParams:
+    """stop_distance: () stop when the geodesic distance is below this, m."""
+
+    stop_distance: jax.Array
+
+
+def _path_act(params, obs, answers, pstate, key, priv):
+    stop = (priv.geodesic <= params.stop_distance) | ~(priv.best_value < priv.geodesic)
+    mv = T.Action.make(T.MOVE, priv.best_direction, priv.best_col, priv.best_row)
+    return jax.tree.map(lambda s, m: jnp.where(stop, s, m), T.Action.make(T.STOP), mv), pstate + 1
+
+
+SHORTEST_PATH = Agent("shortest_path", _random_init, _path_act, lambda: PathParams(jnp.float32(0.3)), privileged=True,
+                      description="PRIVILEGED upper bound: follows the target's geodesic field")
+
+
+# ---------------------------------------------------------------------------
+# belief machinery shared by explorer, naive asker and EIG agent
+# ---------------------------------------------------------------------------
+
+
+@_pytree
+@dataclass(frozen=True)
+class BeliefParams:
+    """Parameters of the belief-based agents.
+
+    Attributes:
+        costs: (4,) per-type question costs the agent is charged (EIG agent).
+        threshold: () ask when max_t EIG_t / w_t exceeds this (EIG agent).
+        commit: () posterior above which the agent walks to a candidate.
+        p_stop: () posterior needed to stop at a candidate without asking.
+        stop_range: () distance to a candidate at which the agent stops, m.
+        prior_count: () prior expected number of instances of the category.
+    """
+
+    costs: jax.Array
+    threshold: jax.Array
+    commit: jax.Array
+    p_stop: jax.Array
+    stop_range: jax.Array
+    prior_count: jax.Array
+
+
+def default_belief_params(**kw) -> BeliefParams:
+    base = dict(costs=jnp.asarray(LOCKED_COSTS, jnp.float32), threshold=jnp.float32(2.5), commit=jnp.float32(0.5),
+                p_stop=jnp.float32(0.8), stop_range=jnp.float32(1.0), prior_count=jnp.float32(3.0))
+    base.update({k: jnp.asarray(v, jnp.float32) for k, v in kw.items()})
+    return BeliefParams(**base)
+
+
+def _abs_sector(obs: T.Observation):
+    """(8,) relative sector (0..7) of each absolute world sector from the agent's heading."""
+    head = (jnp.round(obs.heading / (math.pi / 4)).astype(jnp.int32)) % 8
+    return (jnp.arange(8) - head) % 8
+
+
+def _sector_likelihood(answer, sectors):
+    """P(route answer sector | hypothesis sector): 0.6 same, 0.2 each neighbour."""
+    diff = jnp.minimum((sectors - answer) % 8, (answer - sectors) % 8)
+    return jnp.where(diff == 0, 0.6, jnp.where(diff == 1, 0.2, 1e-3))
+
+
+def _fold_answers(mem: Memory, obs: T.Observation, answers: T.Answer) -> Memory:
+    """Fold the answer to last step's question (if any) into the belief."""
+    q = mem.last_asked
+    fresh = (q > 0) & ~answers.refused & (answers.last_type == q)
+    M = mem.handle.shape[0]
+    labels = jnp.arange(N_ROOM_LABELS)[:, None]
+    rel = _abs_sector(obs)[None, :]
+    # Type 1: colour
+    colour_bad = (mem.attrs[:, 0] >= 0) & (mem.attrs[:, 0] != answers.color) & (answers.color >= 0)
+    d1 = jnp.where(colour_bad, -8.0, 0.0)
+    u1 = jnp.full((N_ROOM_LABELS, 8), jnp.where(answers.color >= 0, -math.log(N_COLORS), 0.0))
+    # Type 2: room label
+    room_bad = (mem.room >= 0) & (mem.room != answers.room_label) & (answers.room_label >= 0)
+    d2 = jnp.where(room_bad, -4.0, 0.0)
+    u2 = jnp.where((answers.room_label >= 0) & (labels != answers.room_label), -30.0, 0.0) * jnp.ones((1, 8))
+    # Type 3: route sector (relative at asking time = now)
+    _, bearing = candidate_relative(mem, obs)
+    cs = (jnp.round(bearing / (math.pi / 4)).astype(jnp.int32)) % 8
+    d3 = jnp.log(_sector_likelihood(answers.hint_sector, cs))
+    u3 = jnp.log(_sector_likelihood(answers.hint_sector, rel)) * jnp.ones((N_ROOM_LABELS, 1))
+    # Type 4
+    yes = answers.confirm == 1
+    slot = mem.asked_about
+    onehot = jnp.arange(M) == slot
+    d4 = jnp.where(yes, jnp.where(onehot, 0.0, -jnp.inf), 0.0)
+    rej4 = jnp.where(~yes & (slot >= 0), onehot, False)
+    u4 = jnp.where(yes, -jnp.inf, 0.0) * jnp.ones((N_ROOM_LABELS, 8))
+    d = jnp.select([q == 1, q == 2, q == 3, q == 4], [d1, d2, d3, d4], jnp.zeros(M))
+    u = jnp.select([q == 1, q == 2, q == 3, q == 4], [u1, u2, u3, u4], jnp.zeros((N_ROOM_LABELS, 8)))
+    new_hint = fresh & (q == 3)
+    return dataclasses.replace(
+        mem,
+        logw=jnp.where(fresh, mem.logw + d, mem.logw),
+        unseen_logw=jnp.where(fresh, mem.unseen_logw + u, mem.unseen_logw),
+        rejected=mem.rejected | (fresh & (q == 4) & rej4),
+        hint_heading=jnp.where(new_hint, obs.heading + answers.hint_sector.astype(jnp.float32) * (math.pi / 4), mem.hint_heading),
+        has_hint=mem.has_hint | new_hint,
+        pending_stop=mem.pending_stop | (fresh & (q == 4) & yes & (answers.follow_up == T.FOLLOW_ONE_MOVE)),
+    )
+
+
+def belief(mem: Memory, params: BeliefParams):
+    """Posterior over hypotheses: (M,) candidate slots followed by
+    (L * 8,) "not seen yet, room label l, absolute sector s" (row-major)."""
+    valid = (mem.handle >= 0) & ~mem.rejected
+    n_seen = jnp.sum(valid)
+    lw = jnp.where(valid, mem.logw, -jnp.inf)
+    n_unseen = N_ROOM_LABELS * 8
+    lu = jnp.log(jnp.maximum(params.prior_count - n_seen, 0.25)) - math.log(n_unseen) + mem.unseen_logw.reshape(-1)
+    logits = jnp.concatenate([lw, lu])
+    logits = jnp.where(jnp.all(jnp.isneginf(logits)), jnp.zeros_like(logits), logits)
+    return jax.nn.softmax(logits)
+
+
+def _entropy(p, axis=-1):
+    return -jnp.sum(jnp.where(p > 0, p * jnp.log(jnp.where(p > 0, p, 1.0)), 0.0), axis=axis)
+
+
+def expected_information_gain(b, L):
+    """Eq. (1): H[b] - E_{a ~ p(a)} H[b | a] for a likelihood matrix L (A, Hyp)."""
+    pa = L @ b  # Shape: (A,)
+    post = L * b[None] / jnp.where(pa > 0, pa, 1.0)[:, None]
+    return _entropy(b) - jnp.sum(pa * _entropy(post, axis=1))
+
+
+def question_eigs(mem: Memory, obs: T.Observation, answers: T.Answer, b):
+    """(4,) EIG of each question type on belief ``b``; also the Type-4 slot."""
+    M = mem.handle.shape[0]
+    U = N_ROOM_LABELS * 8
+    valid = (mem.handle >= 0) & ~mem.rejected
+    u_label = jnp.repeat(jnp.arange(N_ROOM_LABELS), 8)  # label of each unseen hypothesis
+    u_rel = jnp.tile(_abs_sector(obs), N_ROOM_LABELS)  # relative sector of each unseen hypothesis
+    # Type 1: colour
+    col = mem.attrs[:, 0]
+    L1c = jnp.where(col[None] >= 0, (jnp.arange(N_COLORS)[:, None] == col[None]).astype(jnp.float32), 1.0 / N_COLORS)
+    L1 = jnp.concatenate([L1c, jnp.full((N_COLORS, U), 1.0 / N_COLORS)], axis=1)
+    # Type 2: room label
+    L2c = jnp.where(mem.room[None] >= 0, (jnp.arange(N_ROOM_LABELS)[:, None] == mem.room[None]).astype(jnp.float32),
+                    1.0 / N_ROOM_LABELS)
+    L2u = (jnp.arange(N_ROOM_LABELS)[:, None] == u_label[None]).astype(jnp.float32)
+    L2 = jnp.concatenate([L2c, L2u], axis=1)
+    # Type 3: sector
+    dist, bearing = candidate_relative(mem, obs)
+    cs = (jnp.round(bearing / (math.pi / 4)).astype(jnp.int32)) % 8
+    a = jnp.arange(8)[:, None]
+    L3 = jnp.concatenate([_sector_likelihood(a, cs[None]), _sector_likelihood(a, u_rel[None])], axis=1)
+    L3 = L3 / L3.sum(0, keepdims=True)
+    # Type 4: the most probable candidate in front within 3 m
+    in_front = valid & (dist <= 3.0) & (jnp.abs(bearing) <= math.pi / 4) & jnp.isin(mem.handle, obs.visible_handle)
+    score = jnp.where(in_front, b[:M], -1.0)
+    slot = jnp.argmax(score)
+    has = jnp.any(in_front)
+    yes = jnp.concatenate([(jnp.arange(M) == slot).astype(jnp.float32), jnp.zeros(U)])
+    L4 = jnp.stack([yes, 1.0 - yes])
+    e = jnp.stack([expected_information_gain(b, L) for L in (L1, L2, L3, L4)])
+    e = e * jnp.stack([~answers.known[0], ~answers.known[1], jnp.array(True), has])
+    return jnp.maximum(e, 0.0), jnp.where(has, slot, -1)
+
+
+def unseen_direction(mem: Memory, b):
+    """(heading, concentration): circular mean of the unseen mass over
+    absolute sectors, and its resultant length in [0, 1]."""
+    M = mem.handle.shape[0]
+    mass = b[M:].reshape(N_ROOM_LABELS, 8).sum(0)
+    ang = jnp.arange(8) * (math.pi / 4)
+    x, y = jnp.sum(mass * jnp.cos(ang)), jnp.sum(mass * jnp.sin(ang))
+    total = jnp.maximum(jnp.sum(mass), 1e-9)
+    return jnp.arctan2(y, x), jnp.hypot(x, y) / total
+
+
+def _move_policy(mem: Memory, obs: T.Observation, params: BeliefParams, b, key, hint_weight):
+    """MOVE or STOP from the belief (shared by the belief-based agents)."""
+    M = mem.handle.shape[0]
+    dist, bearing = candidate_relative(mem, obs)
+    bc = b[:M]
+    j = jnp.argmax(bc)
+    committed = bc[j] >= params.commit
+    close = dist[j] <= params.stop_range
+    stuck = (obs.last_move < 0.05) & (mem.t > 0) & (dist[j] <= params.stop_range + 0.8)  # furniture in the way
+    stop = committed & (close | stuck) & (bc[j] >= params.p_stop)
+    approach = move_toward(bearing[j], jnp.clip(dist[j] - 0.5, 0.5, 2.5))
+    head, conc = unseen_direction(mem, b)
+    rel, free = explore_direction(mem, obs, bias=head, bias_weight=hint_weight * conc, rng=key)
+    explore = move_toward(rel, jnp.clip(free - 0.4, 0.8, 2.5))
+    move = jax.tree.map(lambda a, e: jnp.where(committed, a, e), approach, explore)
+    act = jax.tree.map(lambda s, m: jnp.where(stop | mem.pending_stop, s, m), T.Action.make(T.STOP), move)
+    return act, j
+
+
+def _belief_init(params, obs, key):
+    return observe_memory(Memory.empty(), obs)
+
+
+def _finish(mem: Memory, obs, answers, act: T.Action, asked_about):
+    is_ask = act.kind == T.ASK
+    return dataclasses.replace(
+        mem, last_asked=jnp.where(is_ask, act.question, 0).astype(jnp.int32),
+        asked_about=jnp.where(is_ask & (act.question == 4), asked_about, mem.asked_about).astype(jnp.int32),
+        t=mem.t + 1,
+    )
+
+
+def _prepare(params, obs, answers, mem):
+    mem = _fold_answers(mem, obs, answers)
+    mem = observe_memory(mem, obs, jnp.where(answers.known[0], answers.color, -1),
+                         jnp.where(answers.known[1], answers.room_label, -1))
+    return mem, belief(mem, params)
+
+
+def _with_stop_now(answers, mem, act):
+    stop_now = (mem.last_asked == 4) & (answers.confirm == 1) & (answers.follow_up == T.FOLLOW_STOP_NOW)
+    return jax.tree.map(lambda s, a: jnp.where(stop_now, s, a), T.Action.make(T.STOP), act)
+
+
+# explorer -------------------------------------------------------------------
+
+def _explorer_act(params, obs, answers, mem, key, priv):
+    mem, _ = _prepare(params, obs, answers, mem)
+    # no answers: every seen candidate is as likely as the others; commit to the nearest
+    valid = (mem.handle >= 0) & ~mem.rejected
+    dist, _ = candidate_relative(mem, obs)
+    nearest = jnp.argmin(jnp.where(valid, dist, jnp.inf))
+    U = N_ROOM_LABELS * 8
+    b = jnp.concatenate([jnp.where(jnp.arange(valid.shape[0]) == nearest, 1.0, 0.0) * jnp.any(valid),
+                         jnp.full(U, 1.0 / U) * (~jnp.any(valid))])
+    act, _ = _move_policy(mem, obs, dataclasses.replace(params, p_stop=jnp.float32(0.5)), b, key, 0.0)
+    return act, _finish(mem, obs, answers, act, -1)
+
+
+EXPLORER = Agent("explorer", _belief_init, _explorer_act, default_belief_params,
+                 description="no questions: explores, stops at the nearest instance of the goal category it saw")
+
+
+# naive asker ------------------------------------------------------------------
+
+def _naive_act(params, obs, answers, mem, key, priv):
+    mem, b = _prepare(params, obs, answers, mem)
+    eigs, slot4 = question_eigs(mem, obs, answers, b)
+    has_q = obs.questions_left > 0
+    M = mem.handle.shape[0]
+    committed = jnp.max(b[:M]) >= params.commit
+    q = jnp.where(~answers.known[0], 1,
+                  jnp.where(~answers.known[1], 2,
+                            jnp.where(slot4 >= 0, 4, jnp.where((mem.t % 3 == 0) & ~committed, 3, 0))))
+    ask = has_q & (q > 0) & ~mem.pending_stop
+    move, _ = _move_policy(mem, obs, params, b, key, 1.5)
+    cand = jnp.where(slot4 >= 0, mem.handle[jnp.maximum(slot4, 0)], -1)
+    act = jax.tree.map(lambda a, m: jnp.where(ask, a, m), T.Action.make(T.ASK, question=jnp.maximum(q, 1), candidate=cand), move)
+    act = _with_stop_now(answers, mem, act)
+    return act, _finish(mem, obs, answers, act, slot4)
+
+
+NAIVE_ASKER = Agent("naive_asker", _belief_init, _naive_act, default_belief_params, asks=True,
+                    description="asks freely (Type 1, 2 first; Type 4 at candidates; Type 3 every third step)")
+
+
+# EIG agent ------------------------------------------------------------------------
+
+def _eig_act(params, obs, answers, mem, key, priv):
+    mem, b = _prepare(params, obs, answers, mem)
+    eigs, slot4 = question_eigs(mem, obs, answers, b)
+    ratio = eigs / jnp.maximum(params.costs, 1e-6)
+    q = jnp.argmax(ratio) + 1
+    ask = (jnp.max(ratio) > params.threshold) & (obs.questions_left > 0) & ~mem.pending_stop
+    move, _ = _move_policy(mem, obs, params, b, key, 2.0)
+    cand = jnp.where(slot4 >= 0, mem.handle[jnp.maximum(slot4, 0)], -1)
+    act = jax.tree.map(lambda a, m: jnp.where(ask, a, m), T.Action.make(T.ASK, question=q, candidate=cand), move)
+    act = _with_stop_now(answers, mem, act)
+    return act, _finish(mem, obs, answers, act, slot4)
+
+
+EIG = Agent("eig", _belief_init, _eig_act, default_belief_params, asks=True,
+            description="cost-aware: asks argmax_t EIG_t / w_t when it exceeds a threshold (Eq. 1 on its belief)")
+
+
+AGENTS = MappingProxyType({a.name: a for a in (RANDOM, SHORTEST_PATH, EXPLORER, NAIVE_ASKER, EIG)})
+"""Built-in agents by name (immutable)."""

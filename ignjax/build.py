@@ -1,0 +1,145 @@
+"""``python -m ignjax.build``: build scenes and benchmarks, inspect sources.
+
+Sub-commands::
+
+    python -m ignjax.build scenes --out DIR [--count N] [--seed S] [--maps]
+    python -m ignjax.build inspect PATH [--json]
+    python -m ignjax.build episodes --scenes PATH... --out FILE.jsonl.gz [--subset N] [--seed S] [--alpha a1,a2,a3,a4]
+    python -m ignjax.build episodes --check FILE
+
+Errors on bad input are printed as one line naming the file, the place in it
+and the reason, and the command exits with status 2 without writing
+half-finished outputs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+from ignjax.errors import IgnjaxError
+
+
+def _progress(iterable, total: int, desc: str, quiet: bool):
+    from tqdm.auto import tqdm
+
+    return tqdm(iterable, total=total, desc=desc, disable=quiet, file=sys.stderr, dynamic_ncols=True)
+
+
+def cmd_scenes(args) -> int:
+    """Generate procedural houses, write them as USD plus a manifest."""
+    from ignjax.scenes import procgen
+    from ignjax.scenes.manifest import manifest_entry, write_manifest
+    from ignjax.scenes.usd import save_usd
+
+    params = procgen.HouseParams(min_rooms=args.min_rooms, max_rooms=args.max_rooms)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    scenes = procgen.generate_houses(args.count, args.seed, params)
+    entries = []
+    for scene in _progress(scenes, len(scenes), "houses", args.quiet):
+        if args.check:
+            from ignjax.scenes.compile import compile_scene
+            from ignjax.scenes.navgrid import GridConfig, build_navgrid, check_reachable
+
+            grid = build_navgrid(compile_scene(scene), GridConfig())
+            check_reachable(scene, grid, scene.id)
+        path = save_usd(scene, out / f"{scene.id}.usda")
+        entries.append(manifest_entry(scene, path))
+        if args.maps:
+            from ignjax.scenes.mapplot import plot_scene_map
+
+            (out / "maps").mkdir(exist_ok=True)
+            plot_scene_map(scene, out / "maps" / f"{scene.id}.png")
+    write_manifest(out, entries, {"seed": args.seed, "count": args.count, "params": params.to_dict()})
+    total = sum(e["instances"] for e in entries)
+    print(f"wrote {len(entries)} houses ({sum(e['rooms'] for e in entries)} rooms, {total} instances) "
+          f"and {out / 'manifest.json'} in {time.perf_counter() - t0:.1f} s")
+    return 0
+
+
+def cmd_inspect(args) -> int:
+    """Summarise any supported scene source."""
+    from ignjax.scenes.io import load_scenes
+    from ignjax.scenes.model import scene_summary
+
+    scenes = load_scenes(args.path)
+    if args.json:
+        if len(scenes) == 1:
+            doc = scene_summary(scenes[0])
+        else:
+            doc = {"source": str(args.path), "scenes": [scene_summary(s) for s in scenes]}
+        sys.stdout.write(json.dumps(doc) + "\n")
+        return 0
+    for s in scenes:
+        cats = s.categories()
+        multi = {c: n for c, n in cats.items() if n > 1}
+        print(f"{s.id}  ({s.meta.source_format}: {s.meta.source})")
+        print(f"  up axis {s.meta.up_axis}, {s.meta.meters_per_unit:g} m/unit; {len(s.rooms)} rooms, {len(s.doors)} doors, "
+              f"{len(s.walls)} walls, {len(s.objects)} objects in {len(cats)} categories")
+        print("  rooms: " + ", ".join(f"{r.id}={r.label}" for r in s.rooms))
+        if multi:
+            print("  several instances: " + ", ".join(f"{c} x{n}" for c, n in sorted(multi.items(), key=lambda kv: -kv[1])))
+        print("  categories: " + ", ".join(f"{c}({n})" for c, n in cats.items()))
+    return 0
+
+
+def cmd_episodes(args) -> int:
+    from ignjax.episodes.cli import run_episodes_command
+
+    return run_episodes_command(args)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python -m ignjax.build", description=__doc__.split("\n\n")[0])
+    sub = p.add_subparsers(dest="command", required=True)
+
+    s = sub.add_parser("scenes", help="generate procedural houses as USD plus manifest.json")
+    s.add_argument("--out", required=True, help="output folder (created if missing)")
+    s.add_argument("--count", type=int, default=12, help="number of houses (default 12)")
+    s.add_argument("--seed", type=int, default=0, help="seed; the same seed gives the same files (default 0)")
+    s.add_argument("--min-rooms", type=int, default=2, help="fewest rooms per house (default 2)")
+    s.add_argument("--max-rooms", type=int, default=12, help="most rooms per house (default 12)")
+    s.add_argument("--maps", action="store_true", help="also write a top-down map PNG per house into OUT/maps/")
+    s.add_argument("--no-check", dest="check", action="store_false",
+                   help="skip compiling each house and checking that every room is reachable")
+    s.add_argument("--quiet", action="store_true", help="no progress bar")
+    s.set_defaults(func=cmd_scenes)
+
+    i = sub.add_parser("inspect", help="summarise a scene source (USD, ProcTHOR JSON/JSONL, glTF/GLB/OBJ, scene folder)")
+    i.add_argument("path")
+    i.add_argument("--json", action="store_true", help="print exactly one JSON object on stdout")
+    i.set_defaults(func=cmd_inspect)
+
+    e = sub.add_parser("episodes", help="build a benchmark from scenes, or --check an episode file")
+    e.add_argument("--scenes", nargs="+", help="scene sources: the scenes/ folder, USD files, ProcTHOR JSON/JSONL, glTF")
+    e.add_argument("--out", help="episode file to write (.jsonl or .jsonl.gz)")
+    e.add_argument("--subset", type=int, default=500, help="size of the balanced evaluation subset (default 500; 0 = all)")
+    e.add_argument("--seed", type=int, default=0, help="seed of every random choice (default 0)")
+    e.add_argument("--alpha", default="0.35,0.25,0.15,0.25", help="difficulty coefficients a1,a2,a3,a4 (sum 1)")
+    e.add_argument("--thresholds", default="0.30,0.60", help="easy/medium and medium/hard thresholds")
+    e.add_argument("--normalize-alpha", action="store_true", help="rescale --alpha to sum 1 instead of rejecting it")
+    e.add_argument("--starts", type=int, default=3, help="start poses sampled per candidate target (default 3)")
+    e.add_argument("--check", metavar="FILE", help="validate an episode file (against its scenes too) and print its counts")
+    e.add_argument("--schema-only", action="store_true", help="with --check: validate the records only, not against the scenes")
+    e.add_argument("--figure", help="where to draw the statistics figure (default: next to --out)")
+    e.add_argument("--quiet", action="store_true", help="no progress bar")
+    e.set_defaults(func=cmd_episodes)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except IgnjaxError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

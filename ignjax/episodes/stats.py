@@ -1,0 +1,144 @@
+"""Benchmark statistics: printed summaries and one figure.
+
+:func:`summarize` counts episodes per difficulty bin, goal-room label,
+target category and scene, and describes distractors per episode and the
+start-distance distribution; :func:`statistics_figure` draws six panels in
+the spirit of the paper's benchmark-statistics figure (difficulty, distractor
+count, same-room distractors, target categories, start distance, goal
+rooms), for the whole corpus and the evaluation subset side by side.
+"""
+
+from __future__ import annotations
+
+import os
+from collections import Counter
+
+import numpy as np
+
+from ignjax.episodes.difficulty import BIN_NAMES, FactorNorms
+
+
+def _start_distance(rec: dict, cons: dict | None, norms: FactorNorms) -> float:
+    if cons is not None and "start_distance" in cons:
+        return float(cons["start_distance"])
+    return float(rec["factors"]["F_start"]) * norms.start_cap  # capped at start_cap
+
+
+def _n_distractors(rec: dict, cons: dict | None, norms: FactorNorms) -> int:
+    if cons is not None:
+        return len(cons["distractors"])
+    f = float(rec["factors"]["F_distractor"])
+    return int(round(np.expm1(f * np.log1p(norms.distractor_cap))))
+
+
+def summarize(records: list[dict], construction: list[dict] | None = None, norms: FactorNorms = FactorNorms()) -> dict:
+    """Counts and distributions of a list of episode records."""
+    cons = {c["episode_id"]: c for c in construction or []}
+    dist = np.array([_start_distance(r, cons.get(r["episode_id"]), norms) for r in records]) if records else np.zeros(0)
+    nd = np.array([_n_distractors(r, cons.get(r["episode_id"]), norms) for r in records]) if records else np.zeros(0)
+    same = np.array([len(cons[r["episode_id"]]["same_room_distractors"]) for r in records if r["episode_id"] in cons])
+    D = np.array([r["difficulty_score"] for r in records]) if records else np.zeros(0)
+    return {
+        "episodes": len(records),
+        "per_bin": {b: sum(r["difficulty"] == b for r in records) for b in BIN_NAMES},
+        "per_room": dict(Counter(r["goal_room"]["label"] for r in records).most_common()),
+        "per_category": dict(Counter(r["target_category"] for r in records).most_common()),
+        "per_scene": dict(Counter(r["scene_id"] for r in records).most_common()),
+        "targets": len({(r["scene_id"], r["target_id"]) for r in records}),
+        "distractors": {"mean": float(nd.mean()) if len(nd) else 0.0, "max": int(nd.max()) if len(nd) else 0,
+                        "values": nd.tolist()},
+        "same_room_distractors": {"mean": float(same.mean()) if len(same) else float("nan"), "values": same.tolist()},
+        "start_distance": {"mean": float(dist.mean()) if len(dist) else 0.0,
+                           "quartiles": [float(q) for q in np.percentile(dist, [25, 50, 75])] if len(dist) else [],
+                           "values": dist.tolist()},
+        "difficulty_score": {"mean": float(D.mean()) if len(D) else 0.0, "values": D.tolist()},
+    }
+
+
+def format_summary(name: str, s: dict, top: int = 10) -> str:
+    """Plain-text lines of a :func:`summarize` result."""
+    lines = [f"{name}: {s['episodes']} episodes, {s['targets']} targets in {len(s['per_scene'])} scenes, "
+             f"{len(s['per_category'])} categories, {len(s['per_room'])} goal-room labels"]
+    lines.append("  difficulty: " + ", ".join(f"{b} {n}" for b, n in s["per_bin"].items())
+                 + f" (mean D {s['difficulty_score']['mean']:.3f})")
+    q = s["start_distance"]["quartiles"]
+    lines.append(f"  distractors per episode: mean {s['distractors']['mean']:.2f}, max {s['distractors']['max']}; "
+                 f"start distance mean {s['start_distance']['mean']:.2f} m" + (f" (quartiles {q[0]:.1f}/{q[1]:.1f}/{q[2]:.1f} m)" if q else ""))
+    lines.append("  goal rooms: " + ", ".join(f"{k} {v}" for k, v in s["per_room"].items()))
+    cats = list(s["per_category"].items())
+    lines.append("  top categories: " + ", ".join(f"{k} {v}" for k, v in cats[:top]) + (f", ... ({len(cats)} in all)" if len(cats) > top else ""))
+    return "\n".join(lines)
+
+
+def statistics_figure(corpus: dict, subset: dict | None, path: str | os.PathLike, title: str = "Benchmark statistics",
+                      thresholds=(0.30, 0.60)):
+    """Draw six panels (corpus in grey, subset in colour) and write a PNG atomically."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(15, 8.5), dpi=110)
+    axes = fig.subplots(2, 3)
+    sets = [("corpus", corpus, "#9e9e9e")] + ([("subset", subset, "#1f77b4")] if subset else [])
+
+    ax = axes[0, 0]
+    width = 0.38
+    for j, (lab, s, col) in enumerate(sets):
+        vals = [s["per_bin"][b] for b in BIN_NAMES]
+        ax.bar(np.arange(3) + (j - 0.5 * (len(sets) - 1)) * width, vals, width, label=lab, color=col)
+    ax.set_xticks(range(3), BIN_NAMES)
+    ax.set_ylabel("episodes")
+    ax.set_title("(a) episodes per difficulty bin")
+    ax.legend()
+
+    ax = axes[0, 1]
+    for lab, s, col in sets:
+        v = np.asarray(s["distractors"]["values"])
+        if len(v):
+            ax.hist(v, bins=np.arange(v.max() + 2) - 0.5, density=True, alpha=0.6, color=col, label=lab)
+    ax.set_xlabel("same-category distractors in the scene")
+    ax.set_ylabel("share of episodes")
+    ax.set_title("(b) distractors per episode")
+    ax.legend()
+
+    ax = axes[0, 2]
+    for lab, s, col in sets:
+        v = np.asarray(s["difficulty_score"]["values"])
+        if len(v):
+            ax.hist(v, bins=np.linspace(0, 1, 26), density=True, alpha=0.6, color=col, label=lab)
+    for t in thresholds:
+        ax.axvline(t, color="k", lw=1, ls="--")
+    ax.set_xlabel("difficulty score D")
+    ax.set_ylabel("density")
+    ax.set_title("(c) difficulty scores and bin thresholds")
+    ax.legend()
+
+    ax = axes[1, 0]
+    base = subset or corpus
+    cats = list(base["per_category"].items())[:20]
+    ax.barh([c.replace("_", " ") for c, _ in cats][::-1], [n for _, n in cats][::-1], color=sets[-1][2])
+    ax.set_xlabel("episodes")
+    ax.set_title(f"(d) top target categories ({len(base['per_category'])} in all)")
+    ax.tick_params(axis="y", labelsize=7)
+
+    ax = axes[1, 1]
+    for lab, s, col in sets:
+        v = np.asarray(s["start_distance"]["values"])
+        if len(v):
+            ax.hist(v, bins=25, density=True, alpha=0.6, color=col, label=lab)
+    ax.set_xlabel("geodesic start-to-target distance (m)")
+    ax.set_ylabel("density")
+    ax.set_title("(e) start distance")
+    ax.legend()
+
+    ax = axes[1, 2]
+    rooms = list(base["per_room"].items())
+    ax.bar(range(len(rooms)), [n for _, n in rooms], color=sets[-1][2])
+    ax.set_xticks(range(len(rooms)), [r.replace("_", " ") for r, _ in rooms], rotation=45, ha="right", fontsize=8)
+    ax.set_ylabel("episodes")
+    ax.set_title("(f) goal-room labels")
+
+    fig.suptitle(title)
+    fig.tight_layout()
+    from ignjax.scenes.mapplot import save_figure
+
+    save_figure(fig, path, 110)
+    return fig

@@ -1,0 +1,149 @@
+"""Rollouts: one jitted ``lax.scan`` over planner steps, vmapped over episodes.
+
+:func:`rollout_episode` runs ONE episode (reset, then ``max_steps`` rounds
+of observe -> act -> step; finished episodes stay finished);
+:func:`rollout` vmaps it over a batch of episodes and jits the whole thing
+once per (agent, batch shape). :func:`rollout_sweep` adds a second vmap over
+agent parameters (e.g. K cost vectors x E episodes in one call).
+
+Agents are pure functions (:class:`ignjax.agents.base.Agent`): ``init`` and
+``act`` see the :class:`~ignjax.sim.types.Observation` and the oracle's
+:class:`~ignjax.sim.types.Answer` only; privileged agents (labelled as such)
+also receive :class:`Privileged` information.
+
+Besides the outcome row, a rollout records a compact trajectory per episode
+(pose after every step, action kind and question type), used for
+trajectory plots and the interaction analyses.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import partial
+
+import jax
+import jax.numpy as jnp
+
+from ignjax.sim import env as E
+from ignjax.sim import types as T
+
+
+@partial(jax.tree_util.register_dataclass, data_fields=["geodesic", "best_direction", "best_col", "best_row", "best_value"],
+         meta_fields=[])
+@dataclass(frozen=True)
+class Privileged:
+    """Information only privileged agents receive.
+
+    Attributes:
+        geodesic: () float32 geodesic distance to the target now.
+        best_direction, best_col, best_row: () int32 the MOVE whose executor
+            waypoint is geodesically closest to the target, among views
+            0..7 x columns {3, 4, 5, 6} x rows {1, 2, 3}.
+        best_value: () float32 geodesic distance at that waypoint.
+    """
+
+    geodesic: jax.Array
+    best_direction: jax.Array
+    best_col: jax.Array
+    best_row: jax.Array
+    best_value: jax.Array
+
+
+def privileged_info(world: E.World, state: T.SimState) -> Privileged:
+    """Planning information for privileged agents (never for others): the
+    executor's waypoint of every candidate cell, scored by the target's
+    geodesic field."""
+    ep = state.episode
+    views, cols, rows = jnp.meshgrid(jnp.arange(8), jnp.array([3, 4, 5, 6]), jnp.array([1, 2, 3]), indexing="ij")
+    views, cols, rows = views.reshape(-1), cols.reshape(-1), rows.reshape(-1)
+    wps = jax.vmap(lambda d, c, r: E.pixel_waypoint(world, ep.scene, state.pose, d, c, r)[0])(views, cols, rows)
+    vals = jax.vmap(lambda xy: E.geodesic_to_target(world, ep, xy))(wps)
+    moved = jnp.linalg.norm(wps - state.pose[None, :2], axis=1)
+    vals = jnp.where(moved > 0.2, vals, jnp.inf)  # a cell that goes nowhere is no plan
+    k = jnp.argmin(vals)
+    return Privileged(geodesic=E.geodesic_to_target(world, ep, state.pose[:2]), best_direction=views[k].astype(jnp.int32),
+                      best_col=cols[k].astype(jnp.int32), best_row=rows[k].astype(jnp.int32), best_value=vals[k])
+
+
+@partial(jax.tree_util.register_dataclass, data_fields=["pose", "kind", "question"], meta_fields=[])
+@dataclass(frozen=True)
+class Trajectory:
+    """Per-step record of one episode.
+
+    Attributes:
+        pose: (S + 1, 3) float32 pose before the first step and after each step.
+        kind: (S,) int32 action kind of each step (-1 after the episode ended).
+        question: (S,) int32 question type of ASK steps, 0 otherwise.
+    """
+
+    pose: jax.Array
+    kind: jax.Array
+    question: jax.Array
+
+
+def rollout_episode(world: E.World, spec: T.EpisodeSpec, agent, params, key: jax.Array):
+    """Run one episode to the end. Returns (OutcomeRow, Trajectory, final SimState)."""
+    cfg = world.config
+    state = E.reset(world, spec)
+    obs = E.observe(world, state)
+    key, k0 = jax.random.split(key)
+    pstate = agent.init(params, obs, k0)
+    priv0 = privileged_info(world, state) if agent.privileged else None
+
+    def body(carry, k):
+        state, obs, pstate, priv = carry
+        action, pstate = agent.act(params, obs, state.answers, pstate, k, priv)
+        was_done = state.done
+        state = E.step(world, state, action)
+        obs = E.observe(world, state)
+        priv = privileged_info(world, state) if agent.privileged else None
+        kind = jnp.where(was_done, -1, jnp.clip(action.kind, 0, 2))
+        q = jnp.where((kind == T.ASK), jnp.clip(action.question, 1, 4), 0)
+        return (state, obs, pstate, priv), (state.pose, kind.astype(jnp.int32), q.astype(jnp.int32))
+
+    keys = jax.random.split(key, cfg.max_steps)
+    (state, _, _, _), (poses, kinds, qs) = jax.lax.scan(body, (state, obs, pstate, priv0), keys)
+    traj = Trajectory(pose=jnp.concatenate([spec.start[None].astype(jnp.float32), poses]), kind=kinds, question=qs)
+    return E.outcome(world, state), traj, state
+
+
+@partial(jax.jit, static_argnames=("agent",))
+def rollout(world: E.World, specs: T.EpisodeSpec, agent, params, key: jax.Array):
+    """Run a batch of episodes (leading axis E of ``specs``) with one agent.
+
+    Returns:
+        (OutcomeRow, Trajectory) with leading axis E.
+    """
+    n = specs.scene.shape[0]
+    keys = jax.random.split(key, n)
+    out, traj, _ = jax.vmap(lambda s, k: rollout_episode(world, s, agent, params, k))(specs, keys)
+    return out, traj
+
+
+@partial(jax.jit, static_argnames=("agent",))
+def rollout_sweep(world: E.World, specs: T.EpisodeSpec, agent, params_batch, key: jax.Array):
+    """Run every episode under every parameter setting (leading axis K of
+    ``params_batch``): K x E episodes in one call, the same key per episode
+    across settings (paired comparisons).
+
+    Returns:
+        (OutcomeRow, Trajectory) with leading axes (K, E).
+    """
+    n = specs.scene.shape[0]
+    keys = jax.random.split(key, n)
+    per_params = lambda p: jax.vmap(lambda s, k: rollout_episode(world, s, agent, p, k))(specs, keys)[:2]  # noqa: E731
+    return jax.vmap(per_params)(params_batch)
+
+
+def pad_specs(specs: T.EpisodeSpec, size: int) -> T.EpisodeSpec:
+    """Pad a batch of specs to ``size`` rows with invalid copies of the last
+    row (padding rows start finished and are masked out of every metric)."""
+    n = specs.scene.shape[0]
+    if n >= size:
+        return specs
+    import dataclasses
+
+    idx = jnp.concatenate([jnp.arange(n), jnp.full(size - n, n - 1)])
+    out = jax.tree.map(lambda a: a[idx], specs)
+    return dataclasses.replace(out, valid=jnp.arange(size) < n)

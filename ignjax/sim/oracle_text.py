@@ -1,0 +1,129 @@
+"""The oracle's words: array facts -> short natural-language answers (host side).
+
+The simulator computes answers as arrays (:class:`ignjax.sim.types.Answer`);
+agents that read language (MLLM agents, logs, reports) get them rendered
+here. The templates are our own wording; they follow the paper's rules:
+
+* Type 1 (appearance) repeats the episode's target description, which
+  never names a room.
+* Type 2 (region) names the goal room and a coarse region, never an
+  appearance detail.
+* Type 3 (route) says which way to go, egocentrically ("to your left"),
+  toward which room and past which landmark: never a digit, a unit, a
+  compass direction, a heading, a coordinate, a step count or a path length
+  (:func:`route_leaks` checks this).
+* Type 4 (confirmation) says yes or no with a short reason and, after a
+  yes, whether to stop now or take one closer move first.
+"""
+
+from __future__ import annotations
+
+import re
+import zlib
+
+from ignjax.scenes import vocab
+from ignjax.sim import types as T
+
+SECTOR_PHRASES = (
+    "straight ahead", "ahead and to your left", "to your left", "behind you on the left",
+    "behind you", "behind you on the right", "to your right", "ahead and to your right",
+)
+"""Egocentric direction of sector k (view layout: 0 front, 2 left, 4 rear, 6 right)."""
+
+HINT_PROGRESS_TEXT = {
+    T.HINT_NONE: "",
+    T.HINT_CLOSER: "You are getting closer to the area the last route hint pointed to.",
+    T.HINT_SAME: "You have not got any closer to the area the last route hint pointed to.",
+    T.HINT_FARTHER: "You are moving away from the area the last route hint pointed to.",
+    T.HINT_REACHED: "You have reached the area the last route hint pointed to.",
+    T.HINT_STOP: "You are close enough to the target to stop if you can see it.",
+}
+
+
+def _pick(options: tuple[str, ...], key: str) -> str:
+    return options[zlib.crc32(key.encode()) % len(options)]
+
+
+def _category(categories: tuple[str, ...], code: int) -> str | None:
+    return vocab.category_display(categories[code]) if 0 <= code < len(categories) else None
+
+
+def _room(code: int) -> str | None:
+    return vocab.ROOM_DISPLAY[vocab.ALL_ROOM_LABELS[code]] if 0 <= code < len(vocab.ALL_ROOM_LABELS) else None
+
+
+def appearance_text(description: str) -> str:
+    """Type 1: the sanitized target description."""
+    return description
+
+
+def region_text(goal_region: str) -> str:
+    """Type 2: the goal room and region fact of the episode."""
+    return goal_region
+
+
+def route_text(room_label: int, sector: int, landmark: int, in_room: bool, categories: tuple[str, ...],
+               key: str = "") -> str:
+    """Type 3: a coarse route hint from its array facts.
+
+    Args:
+        room_label: label code of the room the route leads toward.
+        sector: egocentric sector 0..7 of the way to take.
+        landmark: category code of a landmark on the way, or -1.
+        in_room: the first stretch of the route stays in the current room.
+        categories: the bank's category vocabulary.
+        key: varies the wording deterministically (e.g. episode id + step).
+    """
+    way = SECTOR_PHRASES[int(sector) % 8]
+    room = _room(int(room_label))
+    mark = _category(categories, int(landmark))
+    past = f", past the {mark}" if mark else ""
+    if in_room or room is None:
+        return _pick((f"Stay in this room and head {way}{past}.",
+                      f"You do not need to leave this room yet; go {way}{past}.",
+                      f"Keep to this room and move {way}{past}."), key)
+    return _pick((f"Head {way} and go through toward the {room}{past}.",
+                  f"Take the way {way}; it leads toward the {room}{past}.",
+                  f"Go {way}, in the direction of the {room}{past}."), key)
+
+
+def confirm_text(answer: int, follow_up: int, key: str = "") -> str:
+    """Type 4: yes/no with a short reason and the follow-up instruction."""
+    if answer == 1:
+        if follow_up == T.FOLLOW_STOP_NOW:
+            return _pick(("Yes, that is the one, and you are close enough: stop here.",
+                          "Yes, that is it. You can stop now."), key)
+        return _pick(("Yes, that is the one. Move a little closer, then stop.",
+                      "Yes, that is it; get a little closer and then stop."), key)
+    return _pick(("No, that is not the one you are looking for.",
+                  "No. The one in front of you is not the target.",
+                  "No, the target is not what you are looking at."), key)
+
+
+def refused_text() -> str:
+    return "You have no questions left; keep searching on your own."
+
+
+def hint_progress_text(progress: int) -> str:
+    """Qualitative progress report of an active Type-3 hint after a step."""
+    return HINT_PROGRESS_TEXT.get(int(progress), "")
+
+
+_DIGIT = re.compile(r"\d")
+_UNITS = re.compile(r"\b(met(er|re)s?|cm|mm|km|centimet(er|re)s?|millimet(er|re)s?|feet|foot|ft|yards?|inch(es)?|steps?|paces?|"
+                    r"degrees?|deg|rad(ians?)?|seconds?|minutes?)\b", re.I)
+_COMPASS = re.compile(r"\b(north|south|east|west|north-?east|north-?west|south-?east|south-?west|northern|southern|"
+                      r"eastern|western|heading|bearing|azimuth|compass)\b", re.I)
+_COORD = re.compile(r"\b[xyz]\s*[=:]|\(\s*-?[\d.]+\s*,|\bcoordinates?\b", re.I)
+_NUMBER_WORDS = re.compile(r"\b(zero|one|two|three|four|five|six|seven|eight|nine|ten|eleven|twelve|twenty|thirty|"
+                           r"forty|fifty|hundred|half|quarter|dozen)\b", re.I)
+
+
+def route_leaks(text: str) -> list[str]:
+    """Everything in a Type-3 text that the protocol forbids: digits, number
+    words, units, compass words and headings, coordinates. Empty when clean."""
+    out = []
+    for name, pat in (("digit", _DIGIT), ("unit", _UNITS), ("compass", _COMPASS), ("coordinate", _COORD),
+                      ("number word", _NUMBER_WORDS)):
+        out += [f"{name}: {m.group(0)!r}" for m in pat.finditer(text)]
+    return out

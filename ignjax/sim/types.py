@@ -1,0 +1,343 @@
+"""Core simulator pytrees: configuration, state, actions, observations, answers.
+
+Every array field documents its shape and dtype for ONE episode; under
+``vmap`` a leading batch axis is added. All pytrees are frozen dataclasses
+registered with ``jax.tree_util.register_dataclass`` (static fields listed
+in ``meta_fields``); change them with :func:`dataclasses.replace`.
+
+Codes
+    Action kinds: ``MOVE = 0``, ``ASK = 1``, ``STOP = 2``.
+    Question types: 1 appearance, 2 region, 3 route, 4 confirmation.
+    Stop reasons: 0 running, 1 agent STOP, 2 step budget exhausted.
+    Hint progress: 0 no hint, 1 closer, 2 no change, 3 farther,
+    4 hinted area reached, 5 stop-eligible (target within the stop radius).
+    Follow-up (after a positive Type-4 answer): 0 none, 1 stop now,
+    2 one closer move then stop.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from functools import partial
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from ignjax.errors import ConfigError
+
+MOVE, ASK, STOP = 0, 1, 2
+ACTION_KINDS = ("move", "ask", "stop")
+RUNNING, STOPPED, OUT_OF_STEPS = 0, 1, 2
+STOP_REASONS = ("running", "stop", "step_budget")
+HINT_NONE, HINT_CLOSER, HINT_SAME, HINT_FARTHER, HINT_REACHED, HINT_STOP = 0, 1, 2, 3, 4, 5
+HINT_PROGRESS = ("none", "closer", "no_change", "farther", "reached", "stop_eligible")
+FOLLOW_NONE, FOLLOW_STOP_NOW, FOLLOW_ONE_MOVE = 0, 1, 2
+N_VIEWS = 8
+N_QTYPES = 4
+
+
+def _static(cls):
+    """Register a frozen dataclass whose fields are all pytree children."""
+    names = [f.name for f in dataclasses.fields(cls)]
+    return partial(jax.tree_util.register_dataclass, data_fields=names, meta_fields=[])(cls)
+
+
+@dataclass(frozen=True)
+class SimConfig:
+    """Static simulator configuration (hashable; shapes and limits).
+
+    Attributes:
+        max_steps: planner steps per episode (an ASK is a step); paper: 20.
+        max_questions: questions charged per episode; paper: 10.
+        horizon: longest waypoint a MOVE may command, metres; default 3.
+        collision_distance: forward rays stop motion at this range, m; 0.6.
+        collision_heights: heights of the forward collision rays, m.
+        micro_step: longest single motion of the local controller, m.
+        max_micro_steps: micro-steps per MOVE.
+        eye_height: camera height, m.
+        image_size: (W, H) of a view, pixels (for the grid-to-pixel map).
+        hfov: horizontal field of view of a view, degrees.
+        depth_range: longest valid depth of a pixel ray, m.
+        pullback: distance the waypoint is pulled back from a hit surface, m.
+        waypoint_tolerance: a waypoint closer than this is reached, m.
+        hint_lookahead: Type-3 hints look this far along the shortest path, m; 4.
+        confirm_range: Type-4 says yes only within this distance, m; 3.
+        stop_radius: a confirmed target this close means "stop now", m.
+        hint_reached: the hinted point counts as reached within this, m.
+        obs_rays_per_view: free-space rays per view in the observation.
+        obs_range: range of observation rays and of visibility, m.
+        max_visible: visible-instance slots in the observation.
+        trace_len: question-trace slots (attempts, charged or refused).
+    """
+
+    max_steps: int = 20
+    max_questions: int = 10
+    horizon: float = 3.0
+    collision_distance: float = 0.6
+    collision_heights: tuple[float, ...] = (0.15, 0.6, 1.2)
+    micro_step: float = 0.5
+    max_micro_steps: int = 8
+    eye_height: float = 1.25
+    image_size: tuple[int, int] = (640, 640)
+    hfov: float = 90.0
+    depth_range: float = 10.0
+    pullback: float = 0.3
+    waypoint_tolerance: float = 0.1
+    hint_lookahead: float = 4.0
+    confirm_range: float = 3.0
+    stop_radius: float = 1.0
+    hint_reached: float = 1.0
+    obs_rays_per_view: int = 3
+    obs_range: float = 6.0
+    max_visible: int = 16
+    trace_len: int = 20
+
+    def __post_init__(self):
+        for name in ("max_steps", "max_questions", "max_micro_steps", "obs_rays_per_view", "max_visible", "trace_len"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+                raise ConfigError(None, f"sim.{name}", f"must be a positive integer, got {v!r}")
+        for name in ("horizon", "collision_distance", "micro_step", "eye_height", "hfov", "depth_range",
+                     "hint_lookahead", "confirm_range", "stop_radius", "hint_reached", "obs_range"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0:
+                raise ConfigError(None, f"sim.{name}", f"must be a positive number, got {v!r}")
+        if not 0 < self.hfov < 180:
+            raise ConfigError(None, "sim.hfov", f"must lie in (0, 180) degrees, got {self.hfov}")
+        if self.trace_len < self.max_steps:
+            raise ConfigError(None, "sim.trace_len", f"must be >= max_steps ({self.max_steps}) to hold every question attempt")
+        object.__setattr__(self, "collision_heights", tuple(float(h) for h in self.collision_heights))
+        object.__setattr__(self, "image_size", tuple(int(v) for v in self.image_size))
+
+
+@_static
+@dataclass(frozen=True)
+class Action:
+    """One decision (int32 scalars; out-of-range values are clamped inside a
+    rollout and counted as invalid; :func:`ignjax.sim.env.check_action`
+    rejects them at the API boundary).
+
+    Attributes:
+        kind: () MOVE / ASK / STOP.
+        direction: () view 0..7 (relative yaw +45 deg * k) for MOVE.
+        col: () grid column 1..8 (left to right) for MOVE.
+        row: () grid row 1..8 (bottom to top) for MOVE.
+        question: () question type 1..4 for ASK.
+        candidate: () for Type 4: an instance handle from the observation's
+            visible list, or -1 for "what is in front of me".
+    """
+
+    kind: jax.Array
+    direction: jax.Array
+    col: jax.Array
+    row: jax.Array
+    question: jax.Array
+    candidate: jax.Array
+
+    @staticmethod
+    def make(kind=MOVE, direction=0, col=4, row=2, question=1, candidate=-1) -> "Action":
+        i = lambda v: jnp.asarray(v, jnp.int32)  # noqa: E731
+        return Action(i(kind), i(direction), i(col), i(row), i(question), i(candidate))
+
+
+@_static
+@dataclass(frozen=True)
+class Answer:
+    """What the oracle has said so far, as array facts (the latest answer of
+    each type; text is rendered on the host by :mod:`ignjax.sim.oracle_text`).
+
+    Attributes:
+        known: (4,) bool, a type-t answer has been received.
+        last_type: () int32 type of the latest answer (0: none yet).
+        refused: () bool, the latest question was refused (budget).
+        color, material, size, state: () int32 Type-1 attribute codes from
+            the description's facts (-1 when the description does not say).
+        on_category: () int32 Type-1: category of the support, -1 if unsaid.
+        near_categories: (3,) int32 Type-1: anchor categories said, -1 pad.
+        room_label: () int32 Type-2: goal room label code.
+        region_category: () int32 Type-2: category of the region's anchor (-1).
+        hint_room_label: () int32 Type-3: room label the route leads toward.
+        hint_sector: () int32 Type-3: egocentric direction 0..7 of the route's
+            first turn-off (0 ahead, 2 left, 4 behind, 6 right) at asking time.
+        hint_landmark: () int32 Type-3: category of a landmark on the route (-1).
+        hint_in_room: () bool Type-3: the route's first 4 m stay in this room.
+        hint_point: (2,) float32 world point 4 m along the route (internal).
+        hint_active: () bool, a Type-3 hint is active.
+        hint_progress: () int32 progress code (see module docstring).
+        confirm: () int32 Type-4: 1 yes, 0 no, -1 not asked.
+        follow_up: () int32 follow-up state after a yes.
+    """
+
+    known: jax.Array
+    last_type: jax.Array
+    refused: jax.Array
+    color: jax.Array
+    material: jax.Array
+    size: jax.Array
+    state: jax.Array
+    on_category: jax.Array
+    near_categories: jax.Array
+    room_label: jax.Array
+    region_category: jax.Array
+    hint_room_label: jax.Array
+    hint_sector: jax.Array
+    hint_landmark: jax.Array
+    hint_in_room: jax.Array
+    hint_point: jax.Array
+    hint_active: jax.Array
+    hint_progress: jax.Array
+    confirm: jax.Array
+    follow_up: jax.Array
+
+    @staticmethod
+    def empty() -> "Answer":
+        m1 = jnp.int32(-1)
+        return Answer(known=jnp.zeros(4, bool), last_type=jnp.int32(0), refused=jnp.array(False), color=m1,
+                      material=m1, size=m1, state=m1, on_category=m1, near_categories=jnp.full(3, -1, jnp.int32),
+                      room_label=m1, region_category=m1, hint_room_label=m1, hint_sector=m1, hint_landmark=m1,
+                      hint_in_room=jnp.array(False), hint_point=jnp.zeros(2, jnp.float32), hint_active=jnp.array(False),
+                      hint_progress=jnp.int32(HINT_NONE), confirm=m1, follow_up=jnp.int32(FOLLOW_NONE))
+
+
+@_static
+@dataclass(frozen=True)
+class Observation:
+    """What a policy may see (never the target's identity, pose or distance).
+
+    Attributes:
+        heading: () float32 own yaw, radians.
+        odometry: (3,) float32 (dx, dy, dyaw) from the start pose, world axes.
+        free_space: (8, R) float32 distance to the first obstacle along R
+            horizontal rays spread over each view's field of view, at eye
+            height and at knee height (the minimum), metres, capped at
+            ``obs_range``.
+        visible_handle: (K,) int32 instance handles of visible instances
+            (-1 for empty slots), nearest first.
+        visible_category: (K,) int32 category codes (bank vocabulary).
+        visible_attrs: (K, 4) int32 colour, material, size, state codes (-1 unknown).
+        visible_range: (K,) float32 distance to the instance, metres.
+        visible_bearing: (K,) float32 relative bearing, radians (left positive).
+        visible_view: (K,) int32 view 0..7 the instance appears in.
+        room_label: () int32 label code of the room the agent stands in
+            (a perception stand-in; -1 outside rooms).
+        goal_category: () int32 category code of the instruction ("Find a laptop").
+        steps_left: () int32 planner steps left.
+        questions_left: () int32 questions left.
+        n_questions: (4,) int32 charged questions per type so far.
+        blocked: (8,) bool headings (relative to the current yaw, view
+            layout) found blocked during the last MOVE.
+        last_move: () float32 metres moved by the last MOVE.
+    """
+
+    heading: jax.Array
+    odometry: jax.Array
+    free_space: jax.Array
+    visible_handle: jax.Array
+    visible_category: jax.Array
+    visible_attrs: jax.Array
+    visible_range: jax.Array
+    visible_bearing: jax.Array
+    visible_view: jax.Array
+    room_label: jax.Array
+    goal_category: jax.Array
+    steps_left: jax.Array
+    questions_left: jax.Array
+    n_questions: jax.Array
+    blocked: jax.Array
+    last_move: jax.Array
+
+
+@_static
+@dataclass(frozen=True)
+class EpisodeSpec:
+    """The fixed facts of one episode, carried in the state (never observed
+    directly; the oracle reads them).
+
+    Attributes:
+        scene: () int32 scene index in the bank.
+        target: () int32 target instance index in its scene.
+        field: () int32 index of the target's geodesic field.
+        category: () int32 target category code.
+        start: (3,) float32 start pose (x, y, yaw).
+        difficulty: () int32 bin (0 easy, 1 medium, 2 hard).
+        goal_room: () int32 goal room index in the scene (-1 unknown).
+        fact_attrs: (4,) int32 the description's colour/material/size/state (-1 unsaid).
+        fact_on: () int32 support category said by the description (-1).
+        fact_near: (3,) int32 anchor categories said by the description (-1 pad).
+        region_category: () int32 region anchor category of the Type-2 fact (-1).
+        valid: () bool, a real episode (False for batch padding).
+    """
+
+    scene: jax.Array
+    target: jax.Array
+    field: jax.Array
+    category: jax.Array
+    start: jax.Array
+    difficulty: jax.Array
+    goal_room: jax.Array
+    fact_attrs: jax.Array
+    fact_on: jax.Array
+    fact_near: jax.Array
+    region_category: jax.Array
+    valid: jax.Array
+
+
+@_static
+@dataclass(frozen=True)
+class SimState:
+    """The state of one episode.
+
+    Attributes:
+        episode: the episode's fixed facts.
+        pose: (3,) float32 (x, y, yaw).
+        step: () int32 planner steps used.
+        n_questions: (4,) int32 charged questions per type.
+        n_refused: () int32 questions refused (budget exhausted), not charged.
+        n_invalid: () int32 out-of-range actions clamped inside the rollout.
+        trace_type: (T,) int32 question type of each attempt (0 = empty slot).
+        trace_step: (T,) int32 planner step of each attempt (-1 = empty).
+        trace_charged: (T,) bool, the attempt was charged (False: refused).
+        n_trace: () int32 attempts recorded.
+        path_length: () float32 metres travelled.
+        min_distance: () float32 smallest geodesic distance to the target so far.
+        done: () bool, the episode has ended.
+        stop_reason: () int32 stop reason code.
+        blocked: (8,) bool relative headings blocked during the last MOVE.
+        last_move: () float32 metres moved by the last MOVE.
+        waypoint: (2,) float32 the last MOVE's waypoint (world).
+        moves_since_confirm: () int32 MOVEs since a positive Type-4 answer.
+        answers: the oracle's answers so far (see :class:`Answer`).
+    """
+
+    episode: EpisodeSpec
+    pose: jax.Array
+    step: jax.Array
+    n_questions: jax.Array
+    n_refused: jax.Array
+    n_invalid: jax.Array
+    trace_type: jax.Array
+    trace_step: jax.Array
+    trace_charged: jax.Array
+    n_trace: jax.Array
+    path_length: jax.Array
+    min_distance: jax.Array
+    done: jax.Array
+    stop_reason: jax.Array
+    blocked: jax.Array
+    last_move: jax.Array
+    waypoint: jax.Array
+    moves_since_confirm: jax.Array
+    answers: Answer
+
+
+def tree_select(pred, on_true, on_false):
+    """Elementwise ``where`` over two pytrees of the same structure."""
+    return jax.tree.map(lambda a, b: jnp.where(pred, a, b), on_true, on_false)
+
+
+def numpy_tree(tree):
+    """A pytree of device arrays as numpy arrays (host copy)."""
+    return jax.tree.map(lambda a: np.asarray(a), tree)
