@@ -20,7 +20,7 @@ import sys
 import time
 from pathlib import Path
 
-from ignjax.errors import IgnjaxError
+from ignjax.errors import IgnjaxError, SceneError
 
 
 def _progress(iterable, total: int, desc: str, quiet: bool):
@@ -88,6 +88,51 @@ def cmd_inspect(args) -> int:
     return 0
 
 
+def cmd_render(args) -> int:
+    """Top-down map and first-person 8-view panorama of a scene."""
+    import math
+
+    import numpy as np
+
+    from ignjax.scenes.compile import compile_scene
+    from ignjax.scenes.io import load_scenes
+    from ignjax.scenes.mapplot import plot_scene_map
+    from ignjax.scenes.navgrid import GridConfig, build_navgrid
+    from ignjax.sim.render import VIEW_NAMES, ViewRenderer, save_png
+
+    scenes = load_scenes(args.path)
+    if args.scene:
+        scenes = [s for s in scenes if s.id == args.scene]
+        if not scenes:
+            raise SceneError(args.path, "--scene", f"no scene {args.scene!r} in the source")
+    scene = scenes[0]
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    compiled = compile_scene(scene)
+    if args.pose:
+        x, y, yaw = (float(v) for v in args.pose.split(","))
+    else:  # the navigable cell farthest from obstacles in the first room, facing its centroid
+        grid = build_navgrid(compiled, GridConfig())
+        room0 = grid.room_index(scene.rooms[0].id)
+        clear = np.where(grid.navigable & (grid.room == room0), grid.clearance, -1)
+        r, c = np.unravel_index(int(np.argmax(clear)), clear.shape)
+        x, y = grid.cell_to_world(np.array([r, c]))
+        cx, cy = scene.rooms[0].centroid
+        yaw = math.atan2(cy - y, cx - x) if (cx - x) ** 2 + (cy - y) ** 2 > 0.25 else 0.0
+    plot_scene_map(scene, out / f"{scene.id}_map.png")
+    with ViewRenderer(compiled.model, compiled.data, args.size, args.size, 90.0) as r:
+        views = r.panorama((x, y, 1.25), yaw, -0.2)
+    save_png(views[0], out / f"{scene.id}_front.png")
+    # 3 x 3 panel in the paper's layout: front-left, front, front-right / left, -, right / rear-left, rear, rear-right
+    layout = [[1, 0, 7], [2, None, 6], [3, 4, 5]]
+    tile = np.full((args.size, args.size, 3), 255, np.uint8)
+    panel = np.concatenate([np.concatenate([views[k] if k is not None else tile for k in row], 1) for row in layout], 0)
+    save_png(panel, out / f"{scene.id}_panorama.png")
+    print(f"wrote {out / (scene.id + '_map.png')}, {out / (scene.id + '_front.png')} and "
+          f"{out / (scene.id + '_panorama.png')} (eye at x={x:.2f}, y={y:.2f}, yaw={yaw:.2f}; views {', '.join(VIEW_NAMES)})")
+    return 0
+
+
 def cmd_episodes(args) -> int:
     from ignjax.episodes.cli import run_episodes_command
 
@@ -114,6 +159,14 @@ def build_parser() -> argparse.ArgumentParser:
     i.add_argument("path")
     i.add_argument("--json", action="store_true", help="print exactly one JSON object on stdout")
     i.set_defaults(func=cmd_inspect)
+
+    r = sub.add_parser("render", help="draw a scene's top-down map and render a first-person 8-view panorama")
+    r.add_argument("path", help="a scene source (USD, ProcTHOR JSON, glTF/GLB/OBJ, scene folder)")
+    r.add_argument("--scene", help="scene id, when the source holds several (default: the first)")
+    r.add_argument("--out", default=".", help="output folder (default: current folder)")
+    r.add_argument("--pose", help="eye pose x,y,yaw (metres, radians); default: an open spot of the first room")
+    r.add_argument("--size", type=int, default=320, help="pixels per view (default 320)")
+    r.set_defaults(func=cmd_render)
 
     e = sub.add_parser("episodes", help="build a benchmark from scenes, or --check an episode file")
     e.add_argument("--scenes", nargs="+", help="scene sources: the scenes/ folder, USD files, ProcTHOR JSON/JSONL, glTF")

@@ -108,21 +108,35 @@ def rollout_episode(world: E.World, spec: T.EpisodeSpec, agent, params, key: jax
     return E.outcome(world, state), traj, state
 
 
+def episode_keys(seed: int, indices) -> jax.Array:
+    """One PRNG key per episode, from the seed and the episode's index in its
+    file, so results do not depend on how episodes are batched."""
+    base = jax.random.key(int(seed))
+    return jax.vmap(lambda i: jax.random.fold_in(base, i))(jnp.asarray(indices, jnp.uint32))
+
+
+def _keys(key: jax.Array, n: int) -> jax.Array:
+    return key if key.shape == (n,) else jax.random.split(key, n)
+
+
 @partial(jax.jit, static_argnames=("agent",))
-def rollout(world: E.World, specs: T.EpisodeSpec, agent, params, key: jax.Array):
+def rollout(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.Array):
     """Run a batch of episodes (leading axis E of ``specs``) with one agent.
+
+    Args:
+        keys: (E,) per-episode keys (see :func:`episode_keys`), or one key
+            that is split.
 
     Returns:
         (OutcomeRow, Trajectory) with leading axis E.
     """
-    n = specs.scene.shape[0]
-    keys = jax.random.split(key, n)
+    keys = _keys(keys, specs.scene.shape[0])
     out, traj, _ = jax.vmap(lambda s, k: rollout_episode(world, s, agent, params, k))(specs, keys)
     return out, traj
 
 
 @partial(jax.jit, static_argnames=("agent",))
-def rollout_sweep(world: E.World, specs: T.EpisodeSpec, agent, params_batch, key: jax.Array):
+def rollout_sweep(world: E.World, specs: T.EpisodeSpec, agent, params_batch, keys: jax.Array):
     """Run every episode under every parameter setting (leading axis K of
     ``params_batch``): K x E episodes in one call, the same key per episode
     across settings (paired comparisons).
@@ -130,8 +144,7 @@ def rollout_sweep(world: E.World, specs: T.EpisodeSpec, agent, params_batch, key
     Returns:
         (OutcomeRow, Trajectory) with leading axes (K, E).
     """
-    n = specs.scene.shape[0]
-    keys = jax.random.split(key, n)
+    keys = _keys(keys, specs.scene.shape[0])
     per_params = lambda p: jax.vmap(lambda s, k: rollout_episode(world, s, agent, p, k))(specs, keys)[:2]  # noqa: E731
     return jax.vmap(per_params)(params_batch)
 

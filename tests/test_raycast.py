@@ -21,12 +21,6 @@ GROUPS = rc.ray_groups_mask((1, 2, 3))  # floor, walls, objects, structural
 
 
 @pytest.fixture(scope="module")
-def fast_jit():
-    """fast_rays with the grid as an argument: compiled once per grid shape."""
-    return jax.jit(rc.fast_rays, static_argnames=("include_floor", "rounds", "want_geom"))
-
-
-@pytest.fixture(scope="module")
 def per_ray_jit():
     """vmap of the per-ray fast_ray_hit (grid unbatched): one compilation per grid."""
     return jax.jit(jax.vmap(lambda g, p, v, m: rc.fast_ray_hit(g, p, v, m), in_axes=(None, 0, 0, None)))
@@ -63,8 +57,8 @@ N_CAST = 10_000  # every fast-path call is padded to this many rays: one compila
 
 
 def _cast(fn, rg, pnts, vecs, max_dist):
-    """``fn`` (fast_rays with geoms, or the vmapped per-ray path) on up to
-    N_CAST rays, padded to N_CAST."""
+    """``fn`` (``(per_ray_jit,)``, or a jitted fast_rays) on up to N_CAST
+    rays, padded to N_CAST."""
     n = len(pnts)
     assert n <= N_CAST
     p = np.zeros((N_CAST, 3), np.float32)
@@ -188,20 +182,20 @@ def test_mj_multiray_matches_mj_ray(two_room):
 # ---------------------------------------------------------------------------
 
 
-def _agreement(fast_jit, compiled, grid, rg, pnts, vecs, max_dist):
-    d, g = _cast(fast_jit, rg, pnts, vecs, max_dist)
+def _agreement(fn, compiled, grid, rg, pnts, vecs, max_dist):
+    d, g = _cast(fn, rg, pnts, vecs, max_dist)
     ref, ref_id = rc.mj_rays(compiled, pnts, vecs, GROUPS)
     ok = rc.agreement(d, ref, max_dist, grid.resolution)
     return ok, d, g, ref, ref_id
 
 
 @pytest.mark.parametrize("which", ["two_room", "house"])
-def test_fast_depth_rays_agree_with_mj_ray(which, request, fast_jit, per_ray_jit):
+def test_fast_depth_rays_agree_with_mj_ray(which, request, per_ray_jit):
     """Depth rays: origins at navigable points, heights 0.1-2 m, any yaw,
-    pitch in [-45, 45] degrees, 5 m (the two-room scene through the per-ray
-    path, the house through the batched one)."""
+    pitch in [-45, 45] degrees, 5 m. (The batched fast_rays gives the same
+    numbers: tests/test_bank.py.)"""
     compiled, grid, rg = request.getfixturevalue(which)
-    fn = (per_ray_jit,) if which == "two_room" else fast_jit
+    fn = (per_ray_jit,)
     pnts, vecs = _rays(grid, 500, 20, seed=3)
     ok, d, g, ref, ref_id = _agreement(fn, compiled, grid, rg, pnts, vecs, 5.0)
     print(f"{which}: depth-ray agreement {ok.mean():.5f}")
@@ -212,11 +206,12 @@ def test_fast_depth_rays_agree_with_mj_ray(which, request, fast_jit, per_ray_jit
 
 
 @pytest.mark.parametrize("height", [0.1, 0.3, 0.5, 0.75, 1.0, 1.5])
-def test_fast_collision_rays_agree_with_mj_ray(house, fast_jit, height):
-    """Horizontal collision rays of 0.65 m at several heights."""
+def test_fast_collision_rays_agree_with_mj_ray(house, per_ray_jit, height):
+    """Horizontal collision rays of 0.65 m at several heights (exactly on the
+    5 cm slice lattice, where faces of snapped furniture lie)."""
     compiled, grid, rg = house
     pnts, vecs = _rays(grid, 200, 16, seed=int(height * 100), heights=(height, height), horizontal=True)
-    ok, *_ = _agreement(fast_jit, compiled, grid, rg, pnts, vecs, 0.65)
+    ok, *_ = _agreement((per_ray_jit,), compiled, grid, rg, pnts, vecs, 0.65)
     assert ok.mean() >= 0.995
 
 
@@ -253,24 +248,6 @@ def test_fast_ray_hand_built(two_room, per_ray_jit):
     assert np.isinf(float(one(jnp.asarray(pnts[4], jnp.float32), jnp.asarray(vecs[4], jnp.float32))[0]))
 
 
-def test_fast_ray_per_ray_equals_batched(house, fast_jit, per_ray_jit):
-    """vmap of the per-ray fast_ray_hit gives what the staged fast_rays gives."""
-    compiled, grid, rg = house
-    pnts, vecs = _rays(grid, 200, 20, seed=5)
-    d1, g1 = _cast((per_ray_jit,), rg, pnts, vecs, 5.0)
-    d2, g2 = _cast(fast_jit, rg, pnts, vecs, 5.0)
-    assert np.array_equal(np.isinf(d1), np.isinf(d2))
-    fin = np.isfinite(d1)
-    np.testing.assert_allclose(d1[fin], d2[fin], atol=1e-5)
-    assert np.array_equal(g1, g2)
-    # fast_ray is the distance alone (voxels entirely inside a primitive end the ray
-    # without an exact test: the same distances up to the 10 um the exact tests widen
-    # primitives by, seen along grazing rays)
-    d3 = jax.jit(jax.vmap(lambda p, v: rc.fast_ray(rg, p, v, 5.0)))(jnp.asarray(pnts[:400], jnp.float32),
-                                                                     jnp.asarray(vecs[:400], jnp.float32))
-    np.testing.assert_allclose(np.asarray(d3)[fin[:400]], d1[:400][fin[:400]], atol=1e-3)
-
-
 def test_line_of_sight(two_room):
     compiled, grid, rg = two_room
     los = jax.jit(jax.vmap(lambda a, b: rc.line_of_sight(rg, a, b)))
@@ -289,13 +266,22 @@ def test_line_of_sight(two_room):
         [7.0, 2.0, 1.5],
         [2.5, 3.0, 0.9],
     ])
+    # and 2000 random segments between navigable points (they exercise fast_ray,
+    # whose voxels entirely inside a primitive end a ray without an exact test)
+    rng = np.random.default_rng(7)
+    pts = grid.navigable_points()
+    ra = np.c_[pts[rng.integers(0, len(pts), 2000)], rng.uniform(0.2, 1.8, 2000)]
+    rb = np.c_[pts[rng.integers(0, len(pts), 2000)], rng.uniform(0.2, 1.8, 2000)]
+    a, b = np.concatenate([a, ra]), np.concatenate([b, rb])
     got = np.asarray(los(jnp.asarray(a, jnp.float32), jnp.asarray(b, jnp.float32)))
-    assert got.tolist() == [True, False, True, True, False]
-    # consistent with mj_ray on the same segments
+    assert got[:5].tolist() == [True, False, True, True, False]
+    # consistent with mj_ray on the same segments (up to segments ending within 1 mm of a surface)
     d = b - a
     length = np.linalg.norm(d, axis=1)
     ref, _ = rc.mj_rays(compiled, a, d / length[:, None], GROUPS)
-    assert np.array_equal(got, ref >= length - 0.05)
+    clear = np.abs(ref - (length - 0.05)) > 1e-3
+    assert np.array_equal(got[clear], (ref >= length - 0.05)[clear])
+    assert 0.2 < got.mean() < 0.9
 
 
 @pytest.mark.slow

@@ -274,7 +274,8 @@ def _instance_table(scenes: Sequence[Scene], categories: tuple[str, ...]) -> Ins
     n = max(max(len(s.instances) for s in scenes), 1)
     S = len(scenes)
     cat_index = {c: i for i, c in enumerate(categories)}
-    f = {k: np.full((S, n), -1, np.int32) for k in ("category", "room", "support", "color", "material", "size", "state")}
+    keys = ("category", "room", "support", "color", "material", "size", "state")
+    f = {k: np.full((S, n), -1, np.int32) for k in keys}
     valid = np.zeros((S, n), bool)
     structural = np.zeros((S, n), bool)
     center = np.zeros((S, n, 3), np.float32)

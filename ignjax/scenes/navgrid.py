@@ -164,7 +164,8 @@ class GridConfig:
             pos("max_height")
         ratio = self.list_band_height / self.slice_height
         if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
-            raise _bad("list_band_height", f"must be a whole number of slice_height ({self.slice_height}), got {self.list_band_height}")
+            raise _bad("list_band_height",
+                       f"must be a whole number of slice_height ({self.slice_height}), got {self.list_band_height}")
         try:
             bands = tuple((float(lo), float(hi)) for lo, hi in self.bands)
         except (TypeError, ValueError):
@@ -174,7 +175,8 @@ class GridConfig:
         prev = -math.inf
         for lo, hi in bands:
             if not (math.isfinite(lo) and math.isfinite(hi)) or lo < 0 or hi <= lo or lo < prev:
-                raise _bad("bands", f"bands must be increasing, disjoint (lo, hi) pairs with 0 <= lo < hi, got {self.bands}")
+                raise _bad("bands",
+                           f"bands must be increasing, disjoint (lo, hi) pairs with 0 <= lo < hi, got {self.bands}")
             prev = hi
         object.__setattr__(self, "bands", bands)
         names = tuple(str(n) for n in self.band_names)
@@ -231,7 +233,7 @@ class NavGrid:
         prims: (P, 18) float32 exact primitives, see :data:`PRIM_COLUMNS`.
         prim_geom: (P,) int32 MuJoCo geom id of each primitive.
         seg_start: (H, W, B) int32 first entry of each column segment in ``seg_prims``.
-        seg_count: (H, W, B) int32 number of primitives of each segment.
+        seg_count: (H, W, B) uint8 number of primitives of each segment.
         seg_prims: (M,) int32 primitive indices, segment after segment.
         approx: (H, W, B) bool, segment kept at voxel accuracy.
         n_approx: number of approximate segments that are occupied.
@@ -420,20 +422,14 @@ class _Voxelizer:
         grids = np.meshgrid(*[np.arange(a, b + 1) for a, b in zip(i0, i1)], indexing="ij")
         idx = np.stack([g.ravel() for g in grids], -1)
         d = self.lo + (idx + 0.5) * self.cell - center
-        axes = [np.eye(3)[k] for k in range(3)] + [rot[:, k] for k in range(3)]
-        for a in range(3):
-            for b in range(3):
-                ax = np.cross(np.eye(3)[a], rot[:, b])
-                n = np.linalg.norm(ax)
-                if n > 1e-9:
-                    axes.append(ax / n)
-        ok_g = np.ones(len(idx), bool)
-        ok_s = np.ones(len(idx), bool)
-        for ax in axes:
-            sep = np.abs(d @ ax) - (vh * np.abs(ax)).sum()
-            proj = np.abs(rot.T @ ax)
-            ok_g &= sep <= (grown * proj).sum()
-            ok_s &= sep <= (shrunk * proj).sum()
+        # the 15 separating axes: world axes, box axes and their cross products
+        cross = np.cross(np.eye(3)[:, None, :], rot.T[None, :, :]).reshape(9, 3)
+        norm = np.linalg.norm(cross, axis=1)
+        axes = np.concatenate([np.eye(3), rot.T, cross[norm > 1e-9] / norm[norm > 1e-9, None]])  # Shape: (A, 3)
+        sep = np.abs(d @ axes.T) - np.abs(axes) @ vh  # Shape: (M, A)
+        proj = np.abs(axes @ rot)  # Shape: (A, 3): |axis . box axis j|
+        ok_g = np.all(sep <= proj @ grown, axis=1)
+        ok_s = np.all(sep <= proj @ shrunk, axis=1)
         return idx[ok_g], ok_s[ok_g]
 
     def sub_box(self, idx: np.ndarray, row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -452,9 +448,9 @@ class _Voxelizer:
     def inside(self, idx: np.ndarray, row: np.ndarray) -> np.ndarray:
         """(M,) bool: voxel lies entirely inside the primitive ``row`` (all
         eight corners inside a convex set)."""
-        if len(idx) == 0:
-            return np.zeros(0, bool)
         c, R, h, q = row[0:3], row[3:12].reshape(3, 3), row[12:15], row[15:18]
+        if len(idx) == 0 or 2 * h.min() + 2 * _SHRINK < self.cell.min():
+            return np.zeros(len(idx), bool)  # too thin to hold a whole voxel
         corners = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)], np.float64)
         pts = self.lo + (idx[:, None, :] + corners[None]) * self.cell  # Shape: (M, 8, 3)
         loc = (pts - c) @ R  # local frame
@@ -465,7 +461,8 @@ class _Voxelizer:
         """(M, 3) voxel indices hit by samples of the triangles (spacing < 0.4 voxel)."""
         spacing = 0.4 * float(self.cell.min())
         a, b, c = verts[faces[:, 0]], verts[faces[:, 1]], verts[faces[:, 2]]
-        edge = np.maximum.reduce([np.linalg.norm(b - a, axis=1), np.linalg.norm(c - b, axis=1), np.linalg.norm(a - c, axis=1)])
+        edge = np.maximum.reduce([np.linalg.norm(b - a, axis=1), np.linalg.norm(c - b, axis=1),
+                                  np.linalg.norm(a - c, axis=1)])
         n_sub = np.maximum(np.ceil(edge / spacing).astype(np.int64), 1)
         out = []
         for n in np.unique(n_sub):
@@ -626,7 +623,7 @@ def _voxelize(compiled, config: GridConfig, origin, shape, n_slices):
     if mesh_keys:
         approx[np.concatenate(mesh_keys)] = True
     prim_arr = np.stack(prims).astype(np.float32) if prims else np.zeros((0, N_PRIM_COLUMNS), np.float32)
-    seg = (start.astype(np.int32).reshape(H, W, n_lb), count.astype(np.int32).reshape(H, W, n_lb), seg_prims)
+    seg = (start.astype(np.int32).reshape(H, W, n_lb), count.astype(np.uint8).reshape(H, W, n_lb), seg_prims)
     sub = pack_sub_boxes(sub_lo, sub_hi)
     sub[~occ_ray] = 0
     return occ, occ_ray, full, sub, prim_arr, np.asarray(prim_geom, np.int32), seg, approx.reshape(H, W, n_lb)
@@ -898,7 +895,8 @@ def _edge_costs(nav: jax.Array, res: float):
     }
 
 
-def geodesic_field(navigable: jax.Array, seeds: jax.Array, resolution: float, max_rounds: int | None = None) -> jax.Array:
+def geodesic_field(navigable: jax.Array, seeds: jax.Array, resolution: float,
+                   max_rounds: int | None = None) -> jax.Array:
     """Geodesic distance from seed cells over the navigable grid.
 
     The graph is the 8-connected grid of navigable cells: orthogonal steps

@@ -13,12 +13,16 @@ Two kinds of query serve the rollouts:
   flattened and every ray of the batch is cast in one ``fast_rays`` call.
 * :func:`horizontal_free` and :func:`segment_clear` - the many short
   queries of collision checks, free-space observations and visibility,
-  answered by fixed-step marches over the voxel occupancy (``voxcode < 2``
+  answered by fixed-step marches over the voxel occupancy (``voxcode <= 1``
   of the ray grid, a conservative voxelization): a fixed number of samples
   at a fixed spacing, so their cost under ``vmap`` is predictable. A hit is
   reported at the first occupied sample: never later than the true surface
-  by more than the spacing, and early by at most one voxel (conservative
-  voxels). ``tests/test_sim_rays.py`` measures both against ``mj_ray``.
+  by more than the spacing (corner grazes thinner than the spacing aside),
+  and early only where a real surface lies within about one voxel diagonal
+  of the stopping sample (a ray grazing a wall). Leaving the grid counts as
+  a hit: the exterior behind an outside door behaves like a wall.
+  ``tests/test_sim.py`` measures these bounds against ``mj_ray`` (about 93%
+  of collision rays agree with it within one cell).
 """
 
 from __future__ import annotations
@@ -31,7 +35,7 @@ from jax import custom_batching
 
 from ignjax.sim.raycast import RayGrid, fast_rays
 
-_OCCUPIED_MAX_CODE = 1  # voxcode 0: partly occupied, 1: inside a primitive, >= 2: free
+_OCCUPIED_MAX_CODE = 1  # voxcode 0: partly occupied, 1: inside a primitive, 2: free but touched, >= 3: free
 
 
 @custom_batching.custom_vmap
