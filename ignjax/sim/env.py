@@ -8,7 +8,8 @@ Protocol (paper §3.3, Appendix C; constants in :class:`~ignjax.sim.types.SimCon
 * Every decision is one planner step: MOVE, ASK or STOP. The episode ends
   on STOP or after ``max_steps`` steps; finished episodes stay finished.
 * **MOVE** (view k, cell (col, row)) - the executor takes the cell's centre
-  pixel (Eq. grid-to-pixel), casts the pixel's ray (exact fast path) and
+  pixel (Eq. grid-to-pixel), casts the pixel's ray (voxel traversal with
+  exact primitive tests, :func:`ignjax.sim.rays.march`) and
   back-projects it with the view's intrinsics and the found depth
   (Eqs. camera-backproject / camera-to-world). A pixel with no valid depth
   within ``depth_range`` falls back to the floor-plane intersection (Eq.
@@ -67,7 +68,7 @@ from ignjax.sim import types as T
 _TWO_PI = 2.0 * math.pi
 
 
-@partial(jax.tree_util.register_dataclass, data_fields=["bank", "fields"], meta_fields=["config"])
+@partial(jax.tree_util.register_dataclass, data_fields=["bank", "fields", "bands"], meta_fields=["config"])
 @dataclass(frozen=True)
 class World:
     """Everything a rollout reads that is shared by all episodes.
@@ -77,11 +78,91 @@ class World:
         fields: (F, H, W) float32 geodesic fields of the episodes' targets
             (on the bank's padded grid); episodes index them by ``field``.
         config: static simulator configuration.
+        bands: (S, H, W) uint8 per navigation cell, one bit per probe height
+            (:data:`BAND_BITS`): bit j < len(collision_heights) is set when
+            the voxel column is occupied at ``collision_heights[j]``, then
+            the eye height and :data:`LOW_OBS_HEIGHT` for free-space
+            observations, and bit 7 (:data:`NAV_BIT`) when the cell is
+            navigable. Derived from the bank when not given: one gather
+            answers every height of a probe sample.
     """
 
     bank: SceneBank
     fields: jax.Array
     config: T.SimConfig = T.SimConfig()
+    bands: jax.Array | None = None
+
+    def __post_init__(self):
+        if self.bands is None:
+            object.__setattr__(self, "bands", band_map(self.bank, self.config))
+
+
+LOW_OBS_HEIGHT = 0.45
+DEPTH_ELEVATION = math.radians(55.0)  # steepest pixel ray followed to the full waypoint range
+DEPTH_EXACT_PRIMS = 8  # primitives tested exactly per occupied voxel by the depth ray
+DEPTH_ITERATIONS = 64  # traversal steps of the depth ray (free space is crossed several voxels at a time)
+NAV_BIT = 7
+
+
+def band_heights(config: T.SimConfig) -> tuple[float, ...]:
+    """Heights of the bits of :attr:`World.bands` (collision heights, eye height, low observation height)."""
+    hs = tuple(config.collision_heights) + (config.eye_height, LOW_OBS_HEIGHT)
+    if len(hs) > NAV_BIT:
+        raise ConfigError(f"collision_heights: at most {NAV_BIT - 2} heights are supported, got {len(hs) - 2}")
+    return hs
+
+
+def band_map(bank: SceneBank, config: T.SimConfig) -> jax.Array:
+    """(S, H, W) uint8 probe bits of every navigation cell (see :class:`World`).
+
+    A cell's bit for height h is set when the ray grid's voxel under the
+    cell's centre at slice ``floor(h / slice_height)`` is occupied
+    (``voxcode <= 1``); cells outside the ray grid count as occupied."""
+    g, r = bank.grid, bank.rays
+    nav = np.asarray(g.navigable)
+    S, H, W = nav.shape
+    vox = np.asarray(r.voxcode)
+    rows, cols = np.meshgrid(np.arange(H), np.arange(W), indexing="ij")
+    out = np.zeros((S, H, W), np.uint8)
+    for si in range(S):
+        cx = np.asarray(g.origin[si, 0]) + (cols + 0.5) * g.resolution
+        cy = np.asarray(g.origin[si, 1]) + (rows + 0.5) * g.resolution
+        vc = np.floor((cx - np.asarray(r.origin[si, 0])) / r.resolution).astype(np.int64)
+        vr = np.floor((cy - np.asarray(r.origin[si, 1])) / r.resolution).astype(np.int64)
+        wv, hv, zv = (int(v) for v in np.asarray(r.dims[si]))
+        inside = (vc >= 0) & (vc < wv) & (vr >= 0) & (vr < hv)
+        vcc, vrr = np.clip(vc, 0, vox.shape[3] - 1), np.clip(vr, 0, vox.shape[2] - 1)
+        bits = np.zeros((H, W), np.uint8)
+        for j, h in enumerate(band_heights(config)):
+            k = int(math.floor(h / r.slice_height + 1e-6))
+            occ = (vox[si, min(k, vox.shape[1] - 1), vrr, vcc] <= SR._OCCUPIED_MAX_CODE) if k < zv else np.zeros((H, W), bool)
+            bits |= (np.where(inside, occ, True).astype(np.uint8) << j)
+        bits |= (nav[si].astype(np.uint8) << NAV_BIT)
+        out[si] = bits
+    return jnp.asarray(out)
+
+
+def bands_at(world: World, s, xy):
+    """() int32 probe bits at ``xy`` (``xy`` (..., 2)); outside the grid every
+    height is occupied and the cell is not navigable."""
+    g = world.bank.grid
+    col = jnp.floor((xy[..., 0] - g.origin[s, 0]) / g.resolution).astype(jnp.int32)
+    row = jnp.floor((xy[..., 1] - g.origin[s, 1]) / g.resolution).astype(jnp.int32)
+    inside = (row >= 0) & (col >= 0) & (row < g.shape[s, 0]) & (col < g.shape[s, 1])
+    b = world.bands[s, jnp.clip(row, 0, world.bands.shape[1] - 1), jnp.clip(col, 0, world.bands.shape[2] - 1)]
+    return jnp.where(inside, b.astype(jnp.int32), (1 << NAV_BIT) - 1)
+
+
+def probe_free(world: World, s, xy, heading, mask: int, max_dist: float, step: float):
+    """Free distance along a horizontal ray over the band map: the distance
+    of the last sample before the first one whose bits in ``mask`` are set
+    (``max_dist`` when none is within range). Fixed-step (``step``) march,
+    conservative like :func:`ignjax.sim.rays.horizontal_free`."""
+    n = int(math.ceil(max_dist / step))
+    t = jnp.arange(1, n + 1, dtype=jnp.float32) * step
+    pts = xy[None] + t[:, None] * jnp.stack([jnp.cos(heading), jnp.sin(heading)])[None]
+    hit = (bands_at(world, s, pts) & mask) != 0
+    return jnp.where(jnp.any(hit), t[jnp.argmax(hit)] - step, jnp.float32(max_dist))
 
 
 # ---------------------------------------------------------------------------
@@ -115,7 +196,12 @@ def room_at(world: World, s, xy):
 
 def geodesic_to_target(world: World, ep: T.EpisodeSpec, xy):
     """() float32 geodesic distance from ``xy`` to the episode's target."""
-    return field_at(world.bank, world.fields[ep.field], ep.scene, xy)
+    g = world.bank.grid
+    row, col = _cell(world, ep.scene, xy)
+    inside = (row >= 0) & (col >= 0) & (row < g.shape[ep.scene, 0]) & (col < g.shape[ep.scene, 1])
+    # index the field stack directly: `fields[ep.field]` under vmap would copy a whole field per episode
+    val = world.fields[ep.field, jnp.clip(row, 0, world.fields.shape[1] - 1), jnp.clip(col, 0, world.fields.shape[2] - 1)]
+    return jnp.where(inside, val, jnp.inf)
 
 
 def euclidean_to_target(world: World, ep: T.EpisodeSpec, xy):
@@ -180,9 +266,15 @@ def pixel_waypoint(world: World, s, pose, direction, col, row):
     d_w = G.matvec3(R_wc, d_c)
     norm = jnp.sqrt(d_w[0] * d_w[0] + d_w[1] * d_w[1] + d_w[2] * d_w[2])
     u = d_w / norm
-    # depth by ray casting (exact fast path), batched across episodes
-    dist = SR.cast(world.bank.rays, t_wc[None], u[None], jnp.full((1,), cfg.depth_range, jnp.float32),
-                   jnp.reshape(s, (1,)))[0]
+    # depth by ray casting: voxel traversal with exact primitive tests (SR.march). A surface whose
+    # horizontal distance exceeds horizon + pullback yields the same clipped waypoint as no surface,
+    # so the ray is followed only that far (as a 3-D range, for rays up to DEPTH_ELEVATION steep).
+    horiz = jnp.sqrt(u[0] * u[0] + u[1] * u[1])
+    reach = (cfg.horizon + cfg.pullback + world.bank.grid.resolution) / jnp.maximum(horiz, 1e-3)
+    static = min(cfg.depth_range, (cfg.horizon + cfg.pullback + world.bank.grid.resolution) / math.cos(DEPTH_ELEVATION))
+    dist = SR.march(world.bank.rays, s, t_wc, u, jnp.minimum(jnp.minimum(reach, static), cfg.depth_range),
+                    static_range=static, outside_hits=False, exact=DEPTH_EXACT_PRIMS,
+                    iterations=DEPTH_ITERATIONS)
     valid_depth = jnp.isfinite(dist) & (dist <= cfg.depth_range)
     z = jnp.where(valid_depth, dist / norm, 0.0)  # z-depth along the optical axis (d_c has z = 1)
     x_c = G.backproject(K, uv, z)
@@ -203,12 +295,11 @@ def pixel_waypoint(world: World, s, pose, direction, col, row):
 
 
 def forward_free(world: World, s, xy, heading):
-    """() free distance ahead at the collision heights (min over heights)."""
+    """() free distance ahead at the collision heights (all heights at once, band map)."""
     cfg = world.config
     res = world.bank.grid.resolution
-    ds = [SR.horizontal_free(world.bank.rays, s, xy, heading, h, cfg.collision_distance + res, res / 2)
-          for h in cfg.collision_heights]
-    return jnp.min(jnp.stack(ds))
+    mask = (1 << len(cfg.collision_heights)) - 1
+    return probe_free(world, s, xy, heading, mask, cfg.collision_distance + res, res / 2)
 
 
 def execute_move(world: World, state: T.SimState, direction, col, row):
@@ -229,16 +320,25 @@ def execute_move(world: World, state: T.SimState, direction, col, row):
         headings = h0 + offsets  # Shape: (8,) desired heading first, then nearest neighbours, left first
         lengths = jnp.where(jnp.arange(8) == 0, jnp.minimum(cfg.micro_step, r), cfg.micro_step)
 
-        n_samples = int(math.ceil(cfg.micro_step / (world.bank.grid.resolution / 2)))
-        frac = (jnp.arange(1, n_samples + 1, dtype=jnp.float32)) / n_samples  # Shape: (n,)
+        res = world.bank.grid.resolution
+        spacing = res / 2
+        n_samples = int(math.ceil((cfg.collision_distance + res) / spacing))
+        t = jnp.arange(1, n_samples + 1, dtype=jnp.float32) * spacing  # Shape: (n,)
+        col_mask = (1 << len(cfg.collision_heights)) - 1
 
         def probe(h, length):
-            free = forward_free(world, s, pose[:2], h)
+            # one march over the band map answers the collision rays at every height and the
+            # navigability of every cell along the step (no hopping over a thin gap into another component)
             u = jnp.stack([jnp.cos(h), jnp.sin(h)])
-            # every cell along the step must be navigable (no hopping over a thin gap into another component)
-            nav = jax.vmap(lambda f: navigable_at(world, s, pose[:2] + f * length * u))(frac)
-            full = jnp.all(nav)
-            half = jnp.all(jnp.where(frac <= 0.5, nav, True))
+            pts = jnp.concatenate([pose[None, :2] + t[:, None] * u[None], (pose[:2] + length * u)[None],
+                                   (pose[:2] + 0.5 * length * u)[None]])
+            bits = bands_at(world, s, pts)
+            hit = (bits[:n_samples] & col_mask) != 0
+            free = jnp.where(jnp.any(hit), t[jnp.argmax(hit)] - spacing, jnp.float32(cfg.collision_distance + res))
+            nav = (bits >> NAV_BIT) & 1
+            along = nav[:n_samples] == 1
+            full = jnp.all(jnp.where(t <= length, along, True)) & (nav[n_samples] == 1)
+            half = jnp.all(jnp.where(t <= 0.5 * length, along, True)) & (nav[n_samples + 1] == 1)
             return free >= cfg.collision_distance, full, half
 
         ray_ok, full_ok, half_ok = jax.vmap(probe)(headings, lengths)
@@ -313,11 +413,11 @@ def route_facts(world: World, ep: T.EpisodeSpec, pose):
     bank = world.bank
     g = bank.grid
     s = ep.scene
-    fld = world.fields[ep.field]
+    fi = ep.field
     res = g.resolution
     n = int(math.ceil(cfg.hint_lookahead / res))
     row0, col0 = _cell(world, s, pose[:2])
-    Hh, Ww = fld.shape
+    Hh, Ww = world.fields.shape[1:]
     nbr = jnp.array([[-1, -1], [-1, 0], [-1, 1], [0, -1], [0, 1], [1, -1], [1, 0], [1, 1]], jnp.int32)
     cost = jnp.where(jnp.all(nbr != 0, axis=1), res * math.sqrt(2), res).astype(jnp.float32)
     room0 = room_at(world, s, pose[:2])
@@ -326,8 +426,8 @@ def route_facts(world: World, ep: T.EpisodeSpec, pose):
         r, c, travelled, exit_r, exit_c, left = carry
         rr = jnp.clip(r + nbr[:, 0], 0, Hh - 1)
         cc = jnp.clip(c + nbr[:, 1], 0, Ww - 1)
-        vals = fld[rr, cc]
-        here = fld[jnp.clip(r, 0, Hh - 1), jnp.clip(c, 0, Ww - 1)]
+        vals = world.fields[fi, rr, cc]
+        here = world.fields[fi, jnp.clip(r, 0, Hh - 1), jnp.clip(c, 0, Ww - 1)]
         k = jnp.argmin(vals)
         better = (vals[k] < here) & (travelled < cfg.hint_lookahead)
         nr = jnp.where(better, rr[k], r)
@@ -490,9 +590,11 @@ def observe(world: World, state: T.SimState) -> T.Observation:
         rel = (jnp.arange(8, dtype=jnp.float32) * (math.pi / 4))[:, None] + within[None]  # Shape: (8, R)
         heads = pose[2] + rel
 
+        n_col = len(cfg.collision_heights)
+        obs_mask = (1 << n_col) | (1 << (n_col + 1))  # eye height and LOW_OBS_HEIGHT
+
         def free(h):
-            return jnp.minimum(SR.horizontal_free(bank.rays, s, pose[:2], h, cfg.eye_height, cfg.obs_range, 2 * res),
-                               SR.horizontal_free(bank.rays, s, pose[:2], h, 0.45, cfg.obs_range, 2 * res))
+            return probe_free(world, s, pose[:2], h, obs_mask, cfg.obs_range, 2 * res)
 
         free_space = jax.vmap(jax.vmap(free))(heads)
         # visible instances: K nearest non-structural instances, kept when in sight

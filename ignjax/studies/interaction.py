@@ -1,0 +1,663 @@
+"""Interaction analyses (paper §4.3): when questions are asked, where Type-3
+questions arise, how questioning grows with difficulty, and how much a
+Type-3 answer shrinks the explored area.
+
+Inputs
+    *Question events* (:func:`events_from_rows` from an outcome table's
+    ``trace`` column, or :func:`events_from_trajectory` from a rollout's
+    :class:`~ignjax.rollout.Trajectory`): a dict of flat arrays ``episode``,
+    ``type`` (1..4), ``step`` (0-based planner step of the ASK), ``charged``,
+    plus per-episode ``steps_used`` and ``difficulty`` (0 easy, 1 medium,
+    2 hard; -1 unknown). *Poses*: ``Trajectory.pose`` (E, S + 1, 3), the pose
+    before step 0 and after every step, so the question asked at step ``s``
+    is asked at ``pose[s]``. Episode ``e`` of the events is row ``e`` of the
+    poses.
+
+Question timing (:func:`question_timing`)
+    Normalised progress of a question = ``step / steps_used`` in [0, 1)
+    (0 = asked at the first step); histogram per type.
+
+Type-3 location (:func:`classify_locations`, :func:`type3_locations`)
+    Geometry, on a free-space mask of the grid (cells outside the grid
+    count as blocked): ``mask="navigable"`` (the grid's navigable mask) or
+    ``mask="layout"`` (:func:`layout_mask`: inside a room and free of
+    anything in the tallest height band -- walls, wardrobes -- eroded by the
+    agent radius, so beds, tables and chairs do not turn a room into a maze
+    of passages); the default ``"auto"`` is ``"layout"`` for a grid with
+    ``room``, ``bands`` and ``config`` (a NavGrid) and ``"navigable"``
+    otherwise. From the question pose (snapped to the nearest free
+    cell centre within ``snap_radius`` if it lies on a blocked cell; class
+    -1 unknown otherwise), cast ``n_rays`` (16) rays at angles
+    ``2 pi k / n``, sampled every half cell up to ``reach`` (2 m); ``L_k`` =
+    distance of the last free sample before the first blocked one
+    (``reach`` if none). Then
+
+    * ``width`` = twice the largest *clearance* (distance from a free cell
+      centre to the nearest blocked cell centre) among the pose's cell and
+      the free ray samples within ``width_radius`` (1.25 m) of the pose: the
+      diameter of the widest free disc the agent sees close by. Measured on
+      the (eroded) mask, it is the wall-to-wall width minus twice the agent
+      radius; room corners and points next to a wall still see the room's
+      wide interior;
+    * ray k is *open* when ``L_k >= open_length`` (1 m); ``sectors`` = number
+      of maximal circular runs of open rays.
+
+    Geometric rule, in order: all rays open or ``width > max_width`` (1.6 m)
+    -> ``room``; else ``sectors >= 3`` -> ``junction``; ``sectors == 2`` ->
+    ``corridor`` (bends included: a narrow passage with two ways out);
+    ``sectors == 1`` -> ``dead_end`` (the passage ends within
+    ``open_length``); ``sectors == 0`` -> ``room`` (an enclosed pocket).
+    With the defaults, procedural hallways (1.2-1.6 m wall to wall, 0.84-1.24
+    m on the mask of a 0.18 m agent) and their junctions are narrow.
+
+    Room labels (optional, ``[r.label for r in scene.rooms]`` with the grid's
+    ``room`` index array) then decide room versus passage: a pose in a room
+    whose label is not a passage label (``passage_labels``, default
+    ``hallway``) is ``room`` whatever the local geometry (it is inside a
+    closed room, as the paper counts it); a pose in a passage room keeps its
+    geometric class, a wide spot (``room``) becoming ``corridor``; a pose
+    outside every room keeps its geometric class.
+
+Questions per difficulty (:func:`questions_per_difficulty`)
+    Mean |Q| and mean Q_t per difficulty bin over valid episodes.
+
+Delta-U (:func:`delta_u`, paper line ~317)
+    For a Type-3 question at step ``s`` of an episode that used ``n``
+    steps, the matched horizon is ``m = min(h, s, n - 1 - s)`` planner steps
+    (default h = 5; a question with ``m < min_horizon`` is left out). The
+    *before* path is ``pose[s - m .. s]`` (the m steps before the question),
+    the *after* path ``pose[s + 1 .. s + 1 + m]`` (the m steps after the
+    ASK). The explored area of a path is the area of the coverage cells
+    (``cell`` = 0.25 m squares on a world-aligned lattice) whose centre lies
+    within ``r`` (default 1 m, a short sensing radius) of the path polyline
+    (the segments between consecutive poses, so long MOVEs sweep their whole
+    segment): ``A = cell^2 * #cells``. ``A_noQA`` = area of the before path,
+    ``A_QA`` = area of the after path, ``Delta-U = (A_noQA - A_QA) / A_noQA``
+    (A_noQA >= the area of one disc of radius r > 0). Means per difficulty
+    pool the questions of the bin.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from ignjax.errors import ConfigError, InputError
+from ignjax.studies._common import BIN_NAMES, TYPE_LABELS, as_array, new_figure, save
+
+LOCATION_CLASSES: tuple[str, ...] = ("corridor", "junction", "dead_end", "room")
+CORRIDOR, JUNCTION, DEAD_END, ROOM = range(4)
+UNKNOWN = -1
+
+
+# ---------------------------------------------------------------------------
+# Question events
+# ---------------------------------------------------------------------------
+
+
+def _difficulty_index(value) -> int:
+    if isinstance(value, str):
+        return BIN_NAMES.index(value) if value in BIN_NAMES else -1
+    try:
+        v = int(value)
+    except (TypeError, ValueError):
+        return -1
+    return v if 0 <= v < 3 else -1
+
+
+def events_from_rows(rows: list[dict], *, agent: str | None = None, include_refused: bool = False) -> dict:
+    """Question events of one agent from outcome-table rows
+    (:func:`ignjax.outcomes.read_outcomes`).
+
+    Args:
+        rows: table rows (episode ``e`` = the e-th row of the agent).
+        agent: the agent to keep; required when the rows hold several.
+        include_refused: keep questions refused for budget (not charged).
+
+    Returns:
+        dict with ``episode``, ``type``, ``step`` (N,) int64, ``charged`` (N,)
+        bool, ``steps_used`` (E,), ``difficulty`` (E,) int64, ``episode_id`` (E,).
+    """
+    from ignjax.outcomes import parse_trace
+
+    agents = sorted({str(r.get("agent", "")) for r in rows})
+    if agent is None and len(agents) > 1:
+        raise InputError(None, "agent", f"the rows hold several agents {agents}; name the one to analyse")
+    if agent is not None:
+        rows = [r for r in rows if str(r.get("agent", "")) == agent]
+        if not rows:
+            raise InputError(None, "agent", f"no row of agent {agent!r}; agents are {agents}")
+    ep, ty, st, ch = [], [], [], []
+    for e, r in enumerate(rows):
+        try:
+            trace = parse_trace(r.get("trace", ""))
+        except ValueError as err:
+            raise InputError(None, f"rows[{e}].trace", f"cannot parse {r.get('trace')!r}: {err}") from err
+        for t, s, c in trace:
+            if c or include_refused:
+                ep.append(e), ty.append(t), st.append(s), ch.append(c)
+    return {
+        "episode": np.asarray(ep, np.int64), "type": np.asarray(ty, np.int64), "step": np.asarray(st, np.int64),
+        "charged": np.asarray(ch, bool), "steps_used": np.asarray([int(r["steps"]) for r in rows], np.int64),
+        "difficulty": np.asarray([_difficulty_index(r.get("difficulty")) for r in rows], np.int64),
+        "episode_id": np.asarray([str(r.get("episode_id", "")) for r in rows]),
+    }
+
+
+def events_from_trajectory(trajectory, difficulty=None) -> dict:
+    """Question events from a rollout's trajectories.
+
+    Args:
+        trajectory: a :class:`~ignjax.rollout.Trajectory` (or any object with
+            ``kind`` (E, S) and ``question`` (E, S)); every ASK step is an
+            event (a trajectory does not record whether it was charged, so
+            ``charged`` is all True and refused questions are included).
+        difficulty: optional (E,) bin per episode.
+
+    Returns:
+        the dict of :func:`events_from_rows` (``steps_used`` = steps with
+        ``kind >= 0``).
+    """
+    kind = as_array(trajectory.kind, "trajectory.kind", ndim=2)
+    q = as_array(trajectory.question, "trajectory.question", ndim=2)
+    if q.shape != kind.shape:
+        raise InputError(None, "trajectory.question", f"must match kind's shape {kind.shape}, got {q.shape}")
+    E = kind.shape[0]
+    e, s = np.nonzero(q > 0)
+    if difficulty is None:
+        d = np.full(E, -1, np.int64)
+    else:
+        d = as_array(difficulty, "difficulty", ndim=1).astype(np.int64)
+        if d.shape != (E,):
+            raise InputError(None, "difficulty", f"must have shape ({E},), got {d.shape}")
+    return {"episode": e.astype(np.int64), "type": q[e, s].astype(np.int64), "step": s.astype(np.int64),
+            "charged": np.ones(len(e), bool), "steps_used": (kind >= 0).sum(1).astype(np.int64), "difficulty": d,
+            "episode_id": np.asarray([str(i) for i in range(E)])}
+
+
+def counts_from_events(events: dict) -> np.ndarray:
+    """(E, 4) questions per type per episode."""
+    E = len(events["steps_used"])
+    out = np.zeros((E, 4), np.int64)
+    np.add.at(out, (events["episode"], events["type"] - 1), 1)
+    return out
+
+
+# ---------------------------------------------------------------------------
+# Timing
+# ---------------------------------------------------------------------------
+
+
+def question_timing(events: dict, bins: int = 10) -> dict:
+    """Histogram per type of the normalised progress ``step / steps_used``.
+
+    Returns:
+        dict with ``edges`` (bins + 1,), ``counts`` (4, bins), ``share`` (4, bins)
+        fraction of each type's questions per bin (NaN for a type never
+        asked), ``n`` (4,) questions per type, ``episodes_with_type`` (4,)
+        fraction of episodes asking the type at least once, ``progress`` and
+        ``type`` (N,) per question.
+    """
+    if not isinstance(bins, (int, np.integer)) or bins < 1:
+        raise ConfigError(None, "bins", f"must be a positive integer, got {bins!r}")
+    ep, ty, st = events["episode"], events["type"], events["step"]
+    used = np.asarray(events["steps_used"])[ep]
+    if np.any(st >= used) or np.any(st < 0):
+        k = int(np.argmax((st >= used) | (st < 0)))
+        raise InputError(None, f"events[{k}]", f"question step {int(st[k])} outside the episode's {int(used[k])} steps")
+    progress = st / np.maximum(used, 1)
+    idx = np.clip(np.floor(progress * bins).astype(np.int64), 0, bins - 1)
+    counts = np.zeros((4, bins), np.int64)
+    np.add.at(counts, (ty - 1, idx), 1)
+    n = counts.sum(1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        share = np.where(n[:, None] > 0, counts / np.maximum(n, 1)[:, None], np.nan)
+    E = len(events["steps_used"])
+    asked = counts_from_events(events) > 0
+    return {"edges": np.linspace(0, 1, bins + 1), "counts": counts, "share": share, "n": n,
+            "episodes_with_type": asked.mean(0) if E else np.full(4, np.nan), "progress": progress, "type": ty}
+
+
+# ---------------------------------------------------------------------------
+# Type-3 location classes
+# ---------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class LocationParams:
+    """Parameters of the location rule (module docstring).
+
+    Attributes:
+        n_rays: rays cast (>= 4).
+        reach: ray length, metres.
+        open_length: free length making a ray open, metres (<= reach).
+        max_width: largest local free width (on the free-space mask) of a
+            corridor, junction or dead end, metres.
+        width_radius: how far from the pose the local free width looks,
+            metres (<= reach).
+        snap_radius: how far a pose on a blocked cell may be moved to the
+            nearest free cell centre, metres.
+        passage_labels: room labels of passages (see the module docstring).
+    """
+
+    n_rays: int = 16
+    reach: float = 2.0
+    open_length: float = 1.0
+    max_width: float = 1.6
+    width_radius: float = 1.25
+    snap_radius: float = 0.25
+    passage_labels: tuple[str, ...] = ("hallway",)
+
+    def __post_init__(self):
+        if not isinstance(self.n_rays, int) or self.n_rays < 4:
+            raise ConfigError(None, "LocationParams.n_rays", f"must be an integer >= 4, got {self.n_rays!r}")
+        for name in ("reach", "open_length", "max_width", "width_radius"):
+            v = getattr(self, name)
+            if not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0:
+                raise ConfigError(None, f"LocationParams.{name}", f"must be a positive number, got {v!r}")
+        if not (isinstance(self.snap_radius, (int, float)) and math.isfinite(self.snap_radius) and self.snap_radius >= 0):
+            raise ConfigError(None, "LocationParams.snap_radius", f"must be a non-negative number, got {self.snap_radius!r}")
+        for name in ("open_length", "width_radius"):
+            if getattr(self, name) > self.reach:
+                raise ConfigError(None, f"LocationParams.{name}",
+                                  f"must not exceed reach ({self.reach}), got {getattr(self, name)}")
+
+
+def _grid_parts(grid, mask="auto"):
+    if isinstance(mask, str):
+        if mask == "auto":
+            mask = "layout" if all(hasattr(grid, k) for k in ("room", "bands", "config")) else "navigable"
+        if mask not in ("navigable", "layout"):
+            raise ConfigError(None, "mask", f"must be 'auto', 'navigable', 'layout' or an (H, W) array, got {mask!r}")
+    layout = layout_mask(grid) if isinstance(mask, str) and mask == "layout" else None
+    try:
+        origin = np.asarray(grid.origin, np.float64).reshape(2)
+        res = float(grid.resolution)
+        if layout is not None:
+            free = layout
+        else:
+            free = np.asarray(grid.navigable if isinstance(mask, str) else mask, bool)
+    except (AttributeError, TypeError, ValueError) as e:
+        raise InputError(None, "grid", f"needs navigable (H, W), origin (2,) and resolution: {e}") from e
+    if free.ndim != 2 or not (res > 0):
+        raise InputError(None, "grid", f"the mask must be (H, W) and the resolution positive, got {free.shape}, {res}")
+    return free, origin, res
+
+
+def layout_mask(grid, band: int = -1, agent_radius: float | None = None) -> np.ndarray:
+    """(H, W) bool free space of the room layout: cells inside a room whose
+    disc of ``agent_radius`` (default the grid's) meets no cell that is
+    outside all rooms or occupied in height band ``band`` (default the
+    tallest: walls and tall furniture, not beds, tables or chairs). Uses a
+    :class:`~ignjax.scenes.navgrid.NavGrid`'s ``room``, ``bands``,
+    ``resolution`` and ``config.agent_radius``; contains the navigable mask."""
+    try:
+        room = np.asarray(grid.room)
+        occ = np.asarray(grid.bands)[band]
+        res = float(grid.resolution)
+        radius = float(grid.config.agent_radius if agent_radius is None else agent_radius)
+    except (AttributeError, IndexError, TypeError, ValueError) as e:
+        raise InputError(None, "grid", f"a layout mask needs room, bands, resolution and config.agent_radius: {e}") from e
+    blocked = (room < 0) | occ
+    n = int(math.ceil(radius / res + 0.5))
+    o = np.arange(-n, n + 1)
+    dx = np.maximum(np.abs(o)[None, :] - 0.5, 0.0) * res
+    dy = np.maximum(np.abs(o)[:, None] - 0.5, 0.0) * res
+    disc = dx ** 2 + dy ** 2 < radius ** 2  # cells whose square comes within the radius of the centre
+    return ~ndimage.binary_dilation(blocked, structure=disc, border_value=1) & (room >= 0)
+
+
+def classify_locations(grid, xy, params: LocationParams = LocationParams(), room_labels=None,
+                       mask="auto") -> dict:
+    """Location class of world points on a navigation grid.
+
+    Args:
+        grid: a :class:`~ignjax.scenes.navgrid.NavGrid` or any object with
+            ``navigable`` (H, W), ``origin`` (2,), ``resolution`` (and
+            ``room`` (H, W) room indices for ``room_labels``).
+        xy: (P, 2) world points, metres.
+        params: the rule's parameters.
+        room_labels: optional label per room index (``[r.label for r in
+            scene.rooms]``).
+        mask: ``"auto"`` (default), ``"navigable"``, ``"layout"``
+            (:func:`layout_mask`) or an (H, W) bool free-space array.
+
+    Returns:
+        dict with ``cls`` (P,) int (index into :data:`LOCATION_CLASSES`, -1
+        unknown), ``lengths`` (P, n_rays) free ray lengths (m), ``width`` (P,)
+        local free width (m), ``sectors`` (P,) open sectors, ``snapped`` (P,)
+        bool (the pose was moved to a navigable cell).
+    """
+    nav, origin, res = _grid_parts(grid, mask)
+    H, W = nav.shape
+    p = as_array(xy, "xy", ndim=2, last=2, dtype=np.float64, finite=True)
+    P = p.shape[0]
+    rc = np.floor((p[:, ::-1] - origin[::-1]) / res).astype(np.int64)  # (row, col)
+    inb = (rc[:, 0] >= 0) & (rc[:, 0] < H) & (rc[:, 1] >= 0) & (rc[:, 1] < W)
+    ok = inb.copy()
+    ok[inb] = nav[rc[inb, 0], rc[inb, 1]]
+    start = p.copy()
+    snapped = np.zeros(P, bool)
+    known = ok.copy()
+    if (~ok).any() and nav.any():
+        cand = ~ok
+        _, ind = ndimage.distance_transform_edt(~nav, return_indices=True)
+        rcc = np.clip(rc[cand], 0, [H - 1, W - 1])
+        # nearest navigable cell of the (clipped) cell; its centre must be within snap_radius of the point
+        near = np.stack([ind[0][rcc[:, 0], rcc[:, 1]], ind[1][rcc[:, 0], rcc[:, 1]]], -1)
+        centre = origin + (near[:, ::-1] + 0.5) * res
+        close = np.linalg.norm(centre - p[cand], axis=1) <= params.snap_radius + 1e-9
+        idx = np.nonzero(cand)[0][close]
+        start[idx] = centre[close]
+        snapped[idx] = True
+        known[idx] = True
+        rc[idx] = near[close]
+
+    # clearance (m) of every navigable cell: distance to the nearest non-navigable cell centre (outside = blocked)
+    clear = ndimage.distance_transform_edt(np.pad(nav, 1))[1:-1, 1:-1] * res
+    K = params.n_rays
+    ang = 2 * np.pi * np.arange(K) / K
+    dirs = np.stack([np.cos(ang), np.sin(ang)], -1)  # (K, 2)
+    ds = res / 2
+    n_s = int(math.ceil(params.reach / ds))
+    dist = np.minimum(ds * np.arange(1, n_s + 1), params.reach)  # (S,)
+    lengths = np.zeros((P, K))
+    width = np.zeros(P)
+    c0 = np.zeros(P)
+    c0[known] = clear[rc[known, 0], rc[known, 1]]
+    chunk = max(1, (1 << 22) // (K * n_s))
+    for i in range(0, P, chunk):
+        pts = start[i:i + chunk, None, None, :] + dirs[None, :, None, :] * dist[None, None, :, None]  # (p, K, S, 2)
+        cr = np.floor((pts[..., ::-1] - origin[::-1]) / res).astype(np.int64)
+        inside = (cr[..., 0] >= 0) & (cr[..., 0] < H) & (cr[..., 1] >= 0) & (cr[..., 1] < W)
+        free = np.zeros(inside.shape, bool)
+        free[inside] = nav[cr[..., 0][inside], cr[..., 1][inside]]
+        cl = np.zeros(inside.shape)
+        cl[inside] = clear[cr[..., 0][inside], cr[..., 1][inside]]
+        blocked = ~free
+        first = np.where(blocked.any(-1), blocked.argmax(-1), n_s)  # (p, K) index of the first blocked sample
+        lengths[i:i + chunk] = np.where(first == n_s, params.reach, np.where(first > 0, dist[np.maximum(first - 1, 0)], 0.0))
+        seen = (np.arange(n_s) < first[..., None]) & (dist <= params.width_radius + 1e-9)  # visible, close samples
+        width[i:i + chunk] = 2 * np.maximum(c0[i:i + chunk], np.where(seen, cl, 0.0).max((-1, -2)))
+    open_ = lengths >= params.open_length - 1e-9
+    sectors = (open_ & ~np.roll(open_, 1, axis=1)).sum(1)
+    all_open = open_.all(1)
+    cls = np.select([all_open | (width > params.max_width), sectors >= 3, sectors == 2, sectors == 1],
+                    [ROOM, JUNCTION, CORRIDOR, DEAD_END], ROOM)
+    if room_labels is not None:
+        room = getattr(grid, "room", None)
+        if room is None:
+            raise InputError(None, "grid.room", "room_labels need the grid's room-index array")
+        room = np.asarray(room)
+        labels = np.asarray([str(x) for x in room_labels] + [""])  # index -1 -> ""
+        ridx = np.full(P, -1, np.int64)
+        ridx[known] = room[rc[known, 0], rc[known, 1]]
+        if ridx.max(initial=-1) >= len(labels) - 1:
+            raise InputError(None, "room_labels", f"has {len(labels) - 1} labels but the grid uses room {ridx.max()}")
+        passage = np.isin(labels[ridx], list(params.passage_labels))
+        in_room = (ridx >= 0) & ~passage
+        cls = np.where(in_room, ROOM, np.where(passage & (cls == ROOM), CORRIDOR, cls))
+    cls = np.where(known, cls, UNKNOWN)
+    return {"cls": cls.astype(np.int64), "lengths": lengths, "width": width, "sectors": sectors, "snapped": snapped}
+
+
+def type3_locations(grids, poses, events: dict, *, scene_index=None, room_labels=None,
+                    params: LocationParams = LocationParams(), mask="auto") -> dict:
+    """Location class of every Type-3 question.
+
+    Args:
+        grids: one grid, or a sequence of grids indexed by ``scene_index``.
+        poses: (E, S + 1, 3) (or (E, S + 1, 2)) trajectory poses.
+        events: question events (:func:`events_from_rows` / :func:`events_from_trajectory`).
+        scene_index: (E,) grid index per episode (required with several grids).
+        room_labels: one label sequence per grid (or one, for a single grid).
+        mask: ``"auto"``, ``"navigable"`` or ``"layout"`` (see :func:`classify_locations`).
+
+    Returns:
+        dict with per-question ``episode``, ``step``, ``cls``, ``width``,
+        ``sectors``; ``classes`` (names), ``counts`` (4,), ``n_unknown``,
+        ``fractions`` (4,) over classified questions, ``counts_by_difficulty`` (3, 4).
+    """
+    pz = as_array(poses, "poses", ndim=3, dtype=np.float64)
+    if pz.shape[-1] not in (2, 3):
+        raise InputError(None, "poses", f"last axis must be (x, y[, yaw]), got shape {pz.shape}")
+    sel = events["type"] == 3
+    ep, st = events["episode"][sel], events["step"][sel]
+    if ep.size and (ep.max() >= pz.shape[0] or st.max() >= pz.shape[1]):
+        raise InputError(None, "poses", f"shape {pz.shape} does not cover the events (episode {ep.max()}, step {st.max()})")
+    single = not isinstance(grids, (list, tuple))
+    glist = [grids] if single else list(grids)
+    if single:
+        sidx = np.zeros(pz.shape[0], np.int64)
+        labels = [room_labels]
+    else:
+        if scene_index is None:
+            raise InputError(None, "scene_index", "is required with several grids")
+        sidx = as_array(scene_index, "scene_index", ndim=1).astype(np.int64)
+        if sidx.shape[0] != pz.shape[0] or sidx.min(initial=0) < 0 or sidx.max(initial=0) >= len(glist):
+            raise InputError(None, "scene_index", f"must give one grid index in 0..{len(glist) - 1} per episode")
+        labels = [None] * len(glist) if room_labels is None else list(room_labels)
+        if len(labels) != len(glist):
+            raise InputError(None, "room_labels", f"must hold one label sequence per grid ({len(glist)})")
+    n = len(ep)
+    cls = np.full(n, UNKNOWN, np.int64)
+    width = np.full(n, np.nan)
+    sectors = np.zeros(n, np.int64)
+    xy = pz[ep, st, :2]
+    for g in np.unique(sidx[ep]) if n else []:
+        m = sidx[ep] == g
+        r = classify_locations(glist[g], xy[m], params, labels[g], mask)
+        cls[m], width[m], sectors[m] = r["cls"], r["width"], r["sectors"]
+    known = cls >= 0
+    counts = np.bincount(cls[known], minlength=4)
+    diff = np.asarray(events["difficulty"])[ep]
+    by_d = np.zeros((3, 4), np.int64)
+    kd = known & (diff >= 0)
+    np.add.at(by_d, (diff[kd], cls[kd]), 1)
+    return {"episode": ep, "step": st, "cls": cls, "width": width, "sectors": sectors, "classes": LOCATION_CLASSES,
+            "counts": counts, "n_unknown": int((~known).sum()),
+            "fractions": counts / counts.sum() if counts.sum() else np.full(4, np.nan), "counts_by_difficulty": by_d}
+
+
+# ---------------------------------------------------------------------------
+# Questions per difficulty
+# ---------------------------------------------------------------------------
+
+
+def questions_per_difficulty(n_questions, difficulty, valid=None) -> dict:
+    """Mean questions per episode by difficulty bin.
+
+    Args:
+        n_questions: (..., E, 4) counts (leading axes: agents...).
+        difficulty: (..., E) or (E,) bin indices (0..2; others ignored).
+        valid: optional mask like ``difficulty``.
+
+    Returns:
+        dict with ``mean_total`` (..., 3), ``mean_per_type`` (..., 3, 4) (NaN
+        for an empty bin) and ``count`` (..., 3).
+    """
+    n = as_array(n_questions, "n_questions", last=4, dtype=np.float64, finite=True)
+    if n.ndim < 2:
+        raise InputError(None, "n_questions", f"must be (..., E, 4), got shape {n.shape}")
+    d = as_array(difficulty, "difficulty")
+    try:
+        d = np.broadcast_to(d, n.shape[:-1])
+        v = np.ones(n.shape[:-1], bool) if valid is None else np.broadcast_to(np.asarray(valid, bool), n.shape[:-1])
+    except ValueError as e:
+        raise InputError(None, "difficulty", f"shape {np.shape(difficulty)} does not match n_questions {n.shape}") from e
+    oh = ((d[..., None] == np.arange(3)) & v[..., None]).astype(np.float64)  # (..., E, 3)
+    count = oh.sum(-2)
+    per = np.einsum("...et,...eg->...gt", n, oh)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = np.where(count[..., None] > 0, per / np.maximum(count, 1)[..., None], np.nan)
+    return {"mean_total": mean.sum(-1), "mean_per_type": mean, "count": count.astype(np.int64)}
+
+
+# ---------------------------------------------------------------------------
+# Delta-U
+# ---------------------------------------------------------------------------
+
+
+def explored_area(xy, r: float = 1.0, cell: float = 0.25) -> float:
+    """Area (m^2) of the ``cell`` x ``cell`` lattice squares (lattice aligned
+    with the world origin) whose centre lies within ``r`` of the polyline
+    through the points ``xy`` (M, 2) (a single point: a disc)."""
+    p = as_array(xy, "xy", ndim=2, last=2, dtype=np.float64, finite=True)
+    if p.shape[0] == 0:
+        return 0.0
+    lo = np.floor((p.min(0) - r) / cell).astype(np.int64)
+    hi = np.floor((p.max(0) + r) / cell).astype(np.int64)
+    ix, iy = np.meshgrid(np.arange(lo[0], hi[0] + 1), np.arange(lo[1], hi[1] + 1), indexing="ij")
+    c = (np.stack([ix.ravel(), iy.ravel()], -1) + 0.5) * cell  # (C, 2) centres
+    a = p[:-1] if len(p) > 1 else p
+    b = p[1:] if len(p) > 1 else p
+    ab = b - a  # (G, 2)
+    L2 = (ab * ab).sum(1)
+    t = np.clip(((c[:, None, :] - a[None]) * ab[None]).sum(-1) / np.where(L2 > 0, L2, 1.0)[None], 0.0, 1.0)
+    q = a[None] + t[..., None] * ab[None]
+    d2 = ((c[:, None, :] - q) ** 2).sum(-1).min(1)
+    return float((d2 <= r * r + 1e-12).sum() * cell * cell)
+
+
+def delta_u(poses, events: dict, *, h: int = 5, r: float = 1.0, cell: float = 0.25, min_horizon: int = 1) -> dict:
+    """Explored-area uncertainty proxy of every Type-3 question (module doc).
+
+    Args:
+        poses: (E, S + 1, 2 or 3) trajectory poses.
+        events: question events (only Type 3 are used).
+        h: horizon in planner steps; r: coverage radius, m; cell: lattice
+            size, m; min_horizon: shortest matched horizon kept.
+
+    Returns:
+        dict with per-question ``episode``, ``step``, ``horizon``,
+        ``area_before`` (A_noQA, m^2), ``area_after`` (A_QA, m^2), ``delta_u``
+        (NaN where the horizon is too short), ``difficulty``; and ``mean``,
+        ``median`` (3,) per difficulty over the kept questions (NaN if none),
+        ``count`` (3,), ``mean_all``, ``n_kept``, ``h``, ``r``, ``cell``.
+    """
+    if not isinstance(h, (int, np.integer)) or h < 1:
+        raise ConfigError(None, "delta_u.h", f"must be a positive integer, got {h!r}")
+    for name, val in (("r", r), ("cell", cell)):
+        if not isinstance(val, (int, float)) or not math.isfinite(val) or val <= 0:
+            raise ConfigError(None, f"delta_u.{name}", f"must be a positive number, got {val!r}")
+    pz = as_array(poses, "poses", ndim=3, dtype=np.float64)
+    sel = events["type"] == 3
+    ep, st = events["episode"][sel], events["step"][sel]
+    used = np.asarray(events["steps_used"])[ep]
+    if ep.size and ((used + 1).max() > pz.shape[1] or ep.max() >= pz.shape[0]):
+        raise InputError(None, "poses", f"shape {pz.shape} does not cover the episodes' steps")
+    n = len(ep)
+    horizon = np.minimum(np.minimum(h, st), used - 1 - st)
+    a0 = np.full(n, np.nan)
+    a1 = np.full(n, np.nan)
+    for i in range(n):
+        m, s, e = int(horizon[i]), int(st[i]), int(ep[i])
+        if m < min_horizon:
+            continue
+        a0[i] = explored_area(pz[e, s - m:s + 1, :2], r, cell)
+        a1[i] = explored_area(pz[e, s + 1:s + 2 + m, :2], r, cell)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        du = (a0 - a1) / a0
+    diff = np.asarray(events["difficulty"])[ep]
+    kept = np.isfinite(du)
+    mean, med, cnt = np.full(3, np.nan), np.full(3, np.nan), np.zeros(3, np.int64)
+    for g in range(3):
+        m = kept & (diff == g)
+        cnt[g] = m.sum()
+        if cnt[g]:
+            mean[g], med[g] = du[m].mean(), np.median(du[m])
+    return {"episode": ep, "step": st, "horizon": horizon, "area_before": a0, "area_after": a1, "delta_u": du,
+            "difficulty": diff, "mean": mean, "median": med, "count": cnt,
+            "mean_all": float(du[kept].mean()) if kept.any() else float("nan"), "n_kept": int(kept.sum()),
+            "h": int(h), "r": float(r), "cell": float(cell)}
+
+
+# ---------------------------------------------------------------------------
+# Plots
+# ---------------------------------------------------------------------------
+
+
+def plot_question_timing(result: dict, path: str | os.PathLike, title: str | None = None):
+    """Share of each type's questions per progress bin. ``result``: :func:`question_timing`."""
+    e = result["edges"]
+    centers = 100 * (e[1:] + e[:-1]) / 2
+    fig, axs = new_figure(1, 1, size=(6.5, 4.2))
+    ax = axs[0, 0]
+    for t in range(4):
+        if result["n"][t]:
+            ax.plot(centers, 100 * result["share"][t], marker="o", ms=3, label=f"{TYPE_LABELS[t]} (n={result['n'][t]})")
+    ax.set_xlabel("episode progress when asked (step / steps used, %)")
+    ax.set_ylabel("share of the type's questions (%)")
+    ax.set_xlim(0, 100)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title(title or "When questions are asked", fontsize=10)
+    return save(fig, path)
+
+
+def plot_location_classes(result: dict, path: str | os.PathLike, title: str | None = None):
+    """Share of Type-3 questions per location class. ``result``: :func:`type3_locations`."""
+    fig, axs = new_figure(1, 1, size=(5.5, 4.0))
+    ax = axs[0, 0]
+    x = np.arange(4)
+    frac = np.nan_to_num(result["fractions"])
+    ax.bar(x, 100 * frac, color=["#4c72b0", "#dd8452", "#c44e52", "#55a868"])
+    for i in x:
+        ax.text(i, 100 * frac[i] + 1, f"n={int(result['counts'][i])}", ha="center", fontsize=8)
+    ax.set_xticks(x)
+    ax.set_xticklabels([c.replace("_", " ") for c in LOCATION_CLASSES])
+    ax.set_xlabel("location class at the question pose")
+    ax.set_ylabel("share of Type-3 questions (%)")
+    ax.set_ylim(0, 105)
+    ax.set_title(title or f"Where Type-3 questions arise ({result['n_unknown']} unclassified)", fontsize=10)
+    return save(fig, path)
+
+
+def plot_questions_per_difficulty(result: dict, path: str | os.PathLike, title: str | None = None):
+    """Mean questions per episode by type and difficulty (one agent: the
+    result of :func:`questions_per_difficulty` without leading axes)."""
+    mean = np.asarray(result["mean_per_type"])
+    if mean.ndim != 2:
+        raise InputError(None, "result", "plot one agent's result (mean_per_type of shape (3, 4))")
+    fig, axs = new_figure(1, 1, size=(6.5, 4.2))
+    ax = axs[0, 0]
+    x = np.arange(3)
+    wbar = 0.16
+    for t in range(4):
+        ax.bar(x + (t - 2) * wbar, np.nan_to_num(mean[:, t]), wbar, label=TYPE_LABELS[t])
+    ax.bar(x + 2 * wbar, np.nan_to_num(result["mean_total"]), wbar, color="k", label="|Q| (all types)")
+    ax.set_xticks(x)
+    ax.set_xticklabels([f"{b} (n={int(c)})" for b, c in zip(BIN_NAMES, result["count"])])
+    ax.set_xlabel("episode difficulty")
+    ax.set_ylabel("questions per episode")
+    ax.legend(fontsize=8)
+    ax.set_title(title or "Interaction by difficulty", fontsize=10)
+    return save(fig, path)
+
+
+def plot_delta_u(result: dict, path: str | os.PathLike, title: str | None = None):
+    """Mean Delta-U per difficulty. ``result``: :func:`delta_u`."""
+    fig, axs = new_figure(1, 1, size=(5.5, 4.0))
+    ax = axs[0, 0]
+    x = np.arange(3)
+    m = np.nan_to_num(100 * result["mean"])
+    ax.bar(x, m, color=["#55a868", "#dd8452", "#c44e52"])
+    for i in x:
+        ax.text(i, m[i] + (1 if m[i] >= 0 else -4), f"n={int(result['count'][i])}", ha="center", fontsize=8)
+    ax.axhline(0, color="k", lw=0.8)
+    ax.set_xticks(x)
+    ax.set_xticklabels(list(BIN_NAMES))
+    ax.set_xlabel("episode difficulty")
+    ax.set_ylabel("Delta-U = (A_noQA - A_QA) / A_noQA (%)")
+    ax.set_title(title or f"Type-3 explored-area reduction (h={result['h']} steps, r={result['r']:g} m)", fontsize=10)
+    return save(fig, path)
+
+
+__all__ = ["LOCATION_CLASSES", "UNKNOWN", "LocationParams", "layout_mask", "events_from_rows", "events_from_trajectory",
+           "counts_from_events", "question_timing", "classify_locations", "type3_locations",
+           "questions_per_difficulty", "explored_area", "delta_u", "plot_question_timing", "plot_location_classes",
+           "plot_questions_per_difficulty", "plot_delta_u"]
