@@ -362,8 +362,8 @@ def plot_ordering(result: dict, path: str | os.PathLike, title: str | None = Non
     ax = axs[0, 1]
     a = result["alphas"]
     per_alpha = result["fraction_ordered_by_alpha"]
-    levels = np.unique(np.round(a, 9))
     for k, name in enumerate(FACTOR_NAMES):
+        levels = np.unique(np.round(a[:, k], 9))
         ys = [100 * per_alpha[np.isclose(a[:, k], lv)].mean() for lv in levels]
         ax.plot(levels, ys, marker="o", ms=3, label=name)
     ax.set_xlabel("weight alpha_k of the factor (unitless)")
