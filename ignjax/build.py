@@ -20,7 +20,7 @@ import sys
 import time
 from pathlib import Path
 
-from ignjax.errors import IgnjaxError, SceneError
+from ignjax.errors import ConfigError, IgnjaxError, SceneError
 
 
 def _progress(iterable, total: int, desc: str, quiet: bool):
@@ -37,9 +37,11 @@ def cmd_scenes(args) -> int:
 
     params = procgen.HouseParams(min_rooms=args.min_rooms, max_rooms=args.max_rooms)
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    if out.exists() and not out.is_dir():
+        raise ConfigError(out, "--out", "exists and is not a folder")
     t0 = time.perf_counter()
-    scenes = procgen.generate_houses(args.count, args.seed, params)
+    scenes = procgen.generate_houses(args.count, args.seed, params)  # validates count and seed before anything is written
+    out.mkdir(parents=True, exist_ok=True)
     entries = []
     for scene in _progress(scenes, len(scenes), "houses", args.quiet):
         if args.check:

@@ -149,10 +149,12 @@ def load_benchmark(path: str | os.PathLike, scenes_root: str | os.PathLike | Non
     root = Path(scenes_root) if scenes_root else None
     by_file: dict[Path, set[str]] = {}
     first_line: dict[Path, str] = {}
+    first_use: dict[tuple[Path, str], str] = {}
     for rec in records:
         f = _resolve_scene_file(rec["scene_file"], p, root)
         by_file.setdefault(f, set()).add(rec["scene_id"])
         first_line.setdefault(f, rec["episode_id"])
+        first_use.setdefault((f, rec["scene_id"]), rec["episode_id"])
     scenes = []
     for f, ids in sorted(by_file.items(), key=lambda kv: str(kv[0])):
         try:
@@ -161,7 +163,8 @@ def load_benchmark(path: str | os.PathLike, scenes_root: str | os.PathLike | Non
             raise EpisodeError(p, f"episode {first_line[f]}: scene_file", f"cannot load scene file {str(f)!r}: {e}") from e
         for sid in sorted(ids):
             if sid not in loaded:
-                raise EpisodeError(p, f"scene_id {sid!r}", f"not found in {str(f)!r} (it holds {sorted(loaded)})")
+                raise EpisodeError(p, f"episode {first_use[(f, sid)]}: scene_id",
+                                   f"scene {sid!r} not found in {str(f)!r} (it holds {sorted(loaded)})")
             scenes.append(loaded[sid])
     bank = SceneBank.build(scenes, grid, check=False)
     specs, pairs, field_index = episode_specs(records, bank, p)

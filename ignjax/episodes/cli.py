@@ -101,7 +101,6 @@ def build_episodes(args) -> int:
     config = BuildConfig(seed=args.seed, alpha=alpha, thresholds=thresholds, subset=args.subset,
                          starts_per_target=args.starts)
     sources = scene_sources(args.scenes)
-    out.parent.mkdir(parents=True, exist_ok=True)
     pairs = [(s, Path(os.path.relpath(f.resolve(), out.parent.resolve())).as_posix()) for s, f in sources]
     progress = (lambda it: tqdm(it, desc="scenes", file=sys.stderr, disable=args.quiet, dynamic_ncols=True))
     with warnings.catch_warnings(record=True) as caught:

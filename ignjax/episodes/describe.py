@@ -98,6 +98,10 @@ def choose_facts(scene: Scene, anchors: dict[str, tuple[str, ...]], target: Inst
     by_id = {i.id: i for i in scene.instances}
     a = target.attributes
     support_cat = by_id[target.support].category if target.support and target.support in by_id else None
+    # relations only to categories :func:`read_facts` can read back (the closed target vocabulary);
+    # a relation to any other category would be lost on reading and the check would reject the text
+    if support_cat not in vocab.TARGET_WHITELIST_SET:
+        support_cat = None
     options: list[tuple[str, object]] = []
     if a.color:
         options.append(("color", a.color))
@@ -110,7 +114,8 @@ def choose_facts(scene: Scene, anchors: dict[str, tuple[str, ...]], target: Inst
     anchor_cats: list[str] = []
     for aid in list(unique_anchor_ids) + [x for x in anchors.get(target.id, ()) if x not in unique_anchor_ids]:
         c = by_id[aid].category
-        if c != support_cat and c not in anchor_cats and not by_id[aid].structural:
+        if (c != support_cat and c not in anchor_cats and not by_id[aid].structural
+                and c in vocab.TARGET_WHITELIST_SET):
             anchor_cats.append(c)
     options += [("near", c) for c in anchor_cats]
 

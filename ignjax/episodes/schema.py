@@ -90,7 +90,7 @@ def validate_record(rec: Any, path: str | os.PathLike | None = None, where: str 
         where = f"{where} (episode {eid})"
     if rec.get("schema") != SCHEMA:
         raise EpisodeError(path, f"{where}: schema", f"expected {SCHEMA!r}, got {rec.get('schema')!r}")
-    if rec.get("version") != VERSION:
+    if not (type(rec.get("version")) is int and rec["version"] == VERSION):  # true == 1 and 1.0 == 1 in Python
         raise EpisodeError(path, f"{where}: version", f"unknown schema version {rec.get('version')!r}; this ignjax reads version {VERSION}")
     for key in ("episode_id", "scene_id", "scene_file", "instruction", "target_category", "target_id", "goal_region",
                 "description"):
