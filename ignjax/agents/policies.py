@@ -45,6 +45,9 @@ The EIG agent's belief
     the most probable candidate when its posterior exceeds ``commit``
     (stopping there when closer than ``stop_range`` with posterior at least
     ``p_stop``), else it explores, biased toward the last route hint.
+    In the last ``DEADLINE_STEPS`` planner steps every belief agent heads
+    for its most probable seen candidate and stops there, and its final
+    step is always a STOP (ending without one is a certain failure).
     Because the costs w enter only through EIG / w, raising a cost lowers
     the asking rate of that type.
 """
@@ -68,6 +71,7 @@ from ignjax.scenes import vocab
 from ignjax.sim import types as T
 from ignjax.sim.geometry import wrap_angle
 
+DEADLINE_STEPS = 4  # belief agents commit to their best seen candidate this many steps before the end
 N_COLORS = len(vocab.COLORS)
 N_ROOM_LABELS = len(vocab.ALL_ROOM_LABELS)
 
@@ -291,10 +295,14 @@ def _move_policy(mem: Memory, obs: T.Observation, params: BeliefParams, b, key, 
     dist, bearing = candidate_relative(mem, obs)
     bc = b[:M]
     j = jnp.argmax(bc)
-    committed = bc[j] >= params.commit
+    seen = jnp.any((mem.handle >= 0) & ~mem.rejected)
+    # running out of planner steps: go for the most likely seen candidate, and make the last step a STOP
+    # (success requires a STOP, so ending without one is a certain failure)
+    late = (obs.steps_left <= DEADLINE_STEPS) & seen
+    committed = (bc[j] >= params.commit) | late
     close = dist[j] <= params.stop_range
     stuck = (obs.last_move < 0.05) & (mem.t > 0) & (dist[j] <= params.stop_range + 0.8)  # furniture in the way
-    stop = committed & (close | stuck) & (bc[j] >= params.p_stop)
+    stop = (committed & (close | stuck) & ((bc[j] >= params.p_stop) | late)) | (obs.steps_left <= 1)
     approach = move_toward(bearing[j], jnp.clip(dist[j] - 0.5, 0.5, 2.5))
     head, conc = unseen_direction(mem, b)
     rel, free = explore_direction(mem, obs, bias=head, bias_weight=hint_weight * conc, rng=key)
