@@ -113,6 +113,9 @@ def horizontal_free(grid: RayGrid, scene, xy, heading, height: float, max_dist: 
     return jnp.where(jnp.any(occ), t[first] - step, jnp.float32(max_dist))
 
 
+EXACT_ROUNDS = 6  # exact confirmations per ray: a sub-box hit the primitives miss resumes the traversal
+
+
 def _sub_box_bounds(packed):
     """(lo, hi) fractions of a voxel, (3,) each, from a packed sub-box."""
     v = packed.astype(jnp.int32)
@@ -148,8 +151,11 @@ def march(grid: RayGrid, scene, pnt, vec, max_dist, *, static_range: float, outs
         exact: when > 0, a sub-box hit is confirmed by testing the voxel's
             column-segment primitives exactly (up to ``exact`` of them; a
             segment with more, or one marked approximate, keeps the sub-box
-            hit): distances then agree with ``mj_ray`` to float precision
-            except in such crowded voxels.
+            hit). A hit the primitives miss resumes the traversal from the
+            next voxel, up to :data:`EXACT_ROUNDS` rounds (later rounds take
+            a quarter of the iterations; the last keeps a sub-box hit). The cheap
+            traversal and the few exact tests are separate, so their costs
+            add rather than multiply.
 
         iterations: traversal steps (static); default: enough to cross every
             voxel up to ``static_range``. Free voxels far from geometry are
@@ -176,13 +182,15 @@ def march(grid: RayGrid, scene, pnt, vec, max_dist, *, static_range: float, outs
     limit = jnp.minimum(max_dist, t_floor)
     zmax = grid.voxcode.shape[1] - 1
 
+    vox_shape = jnp.array([grid.voxcode.shape[3] - 1, grid.voxcode.shape[2] - 1, zmax])
+
     def body(_, carry):
-        cell, t_max, t_cur, hit = carry
+        cell, t_max, t_cur, hit, h_ci, h_t0, h_t1, h_rough = carry
         live = jnp.isinf(hit) & (t_cur <= limit)
         out_xy = (cell[0] < 0) | (cell[0] >= dims[0]) | (cell[1] < 0) | (cell[1] >= dims[1])
         above = cell[2] >= dims[2]
         below = cell[2] < 0
-        ci = jnp.clip(cell, 0, jnp.array([grid.voxcode.shape[3] - 1, grid.voxcode.shape[2] - 1, zmax]))
+        ci = jnp.clip(cell, 0, vox_shape)
         code = grid.voxcode[scene, ci[2], ci[1], ci[0]]
         occ = (code <= _OCCUPIED_MAX_CODE) & ~out_xy & ~above & ~below
         lo, hi = _sub_box_bounds(grid.sub_box[scene, ci[2], ci[1], ci[0]])
@@ -194,23 +202,14 @@ def march(grid: RayGrid, scene, pnt, vec, max_dist, *, static_range: float, outs
         t_exit = jnp.min(t_max)
         box_hit = occ & (t_out >= jnp.maximum(t_in, t_cur) - 1e-6) & (t_in <= t_exit + 1e-6)
         t_box = jnp.maximum(t_in, t_cur)
-        if exact:
-            band = jnp.clip(ci[2] // grid.slices_per_band, 0, grid.seg_start.shape[3] - 1)
-            start = grid.seg_start[scene, ci[1], ci[0], band]
-            count = grid.seg_count[scene, ci[1], ci[0], band].astype(jnp.int32)
-            rough = grid.approx[scene, ci[1], ci[0], band] | (count > exact)
-            j = jnp.arange(exact)
-            ids = grid.seg_prims[scene, jnp.clip(start + j, 0, grid.seg_prims.shape[1] - 1)]
-            pid = jnp.clip(ids, 0, grid.prims.shape[2] - 1)
-            f = grid.prims[scene, :, pid].T  # Shape: (18, exact); one gather, never a copy of the scene's table
-            th = _prim_hit(tuple(f[c] for c in range(18)), pnt[0], pnt[1], pnt[2], vec[0], vec[1], vec[2])
-            th = jnp.where((j < count) & (ids >= 0) & (th >= t_cur - 1e-5) & (th <= t_exit + 1e-5), th, inf)
-            t_exact = jnp.min(th)
-            box_hit = box_hit & (rough | jnp.isfinite(t_exact))
-            t_box = jnp.where(rough, t_box, jnp.maximum(t_exact, 0.0))
-        leaves = (out_xy & outside_hits) | (~outside_hits & out_xy)
+        leaves = out_xy & ~outside_hits
         new_hit = jnp.where(box_hit, t_box, jnp.where(out_xy & outside_hits, t_cur, inf))
+        took = live & jnp.isfinite(new_hit)
         hit = jnp.where(live, new_hit, hit)
+        h_ci = jnp.where(took, ci, h_ci)
+        h_t0 = jnp.where(took, t_cur, h_t0)
+        h_t1 = jnp.where(took, t_exit, h_t1)
+        h_rough = jnp.where(took, ~box_hit, h_rough)  # leaving the grid is no voxel to test exactly
         # advance: m DDA steps at once, m - 1 being how many voxels around a free voxel are known free
         # (voxcode c >= 3: chessboard distance c - 2 to the nearest non-free voxel)
         m = jnp.where(occ | (code < 3) | out_xy | below, 1, jnp.maximum(code.astype(jnp.int32) - 3, 1))
@@ -218,13 +217,49 @@ def march(grid: RayGrid, scene, pnt, vec, max_dist, *, static_range: float, outs
         t_new = jnp.min(t_max + (m - 1.0) * t_delta)
         n_cross = jnp.where(t_max <= t_new, jnp.floor((t_new - t_max) / t_delta + 1e-6) + 1.0, 0.0)
         n_cross = jnp.minimum(jnp.where(jnp.isfinite(n_cross), n_cross, 0.0), m)
-        cell = cell + stepi * n_cross.astype(jnp.int32)
-        t_max = t_max + n_cross * t_delta
-        t_exit = jnp.where(live & leaves & ~outside_hits, inf, jnp.where(m > 1, t_new, t_exit))
-        return cell, t_max, t_exit, hit
+        # the state moves past the voxel of a new hit, then freezes there: a later round resumes from it
+        cell = jnp.where(live, cell + stepi * n_cross.astype(jnp.int32), cell)
+        t_next = jnp.where(leaves, inf, jnp.where(m > 1, t_new, t_exit))
+        t_max = jnp.where(live, t_max + n_cross * t_delta, t_max)
+        t_cur = jnp.where(live, t_next, t_cur)
+        return cell, t_max, t_cur, hit, h_ci, h_t0, h_t1, h_rough
 
-    _, _, _, hit = jax.lax.fori_loop(0, n_iter, body, (cell, t_max, jnp.float32(0.0), inf))
-    hit = jnp.where(hit <= limit, hit, inf)
+    def exact_test(ci, t0, t1):
+        """Exact distance within [t0, t1] to the primitives of voxel ci's column segment, and
+        whether the segment is too crowded (or approximate) to answer exactly."""
+        band = jnp.clip(ci[2] // grid.slices_per_band, 0, grid.seg_start.shape[3] - 1)
+        start = grid.seg_start[scene, ci[1], ci[0], band]
+        count = grid.seg_count[scene, ci[1], ci[0], band].astype(jnp.int32)
+        rough = grid.approx[scene, ci[1], ci[0], band] | (count > exact)
+        j = jnp.arange(exact)
+        ids = grid.seg_prims[scene, jnp.clip(start + j, 0, grid.seg_prims.shape[1] - 1)]
+        pid = jnp.clip(ids, 0, grid.prims.shape[2] - 1)
+        f = grid.prims[scene, :, pid].T  # Shape: (18, exact); one gather, never a copy of the scene's table
+        th = _prim_hit(tuple(f[c] for c in range(18)), pnt[0], pnt[1], pnt[2], vec[0], vec[1], vec[2])
+        th = jnp.where((j < count) & (ids >= 0) & (th >= t0 - 1e-5) & (th <= t1 + 1e-5), th, inf)
+        return jnp.maximum(jnp.min(th), 0.0), rough
+
+    state = (cell, t_max, jnp.float32(0.0))
+    zero3 = jnp.zeros(3, jnp.int32)
+    rounds = EXACT_ROUNDS if exact else 1
+    result, pending = inf, jnp.array(True)
+    for r in range(rounds):
+        n_r = n_iter if r == 0 else max(n_iter // 4, 1)
+        carry = (*state, inf, zero3, jnp.float32(0.0), jnp.float32(0.0), jnp.array(False))
+        cell, t_max, t_cur, hit, h_ci, h_t0, h_t1, h_rough = jax.lax.fori_loop(0, n_r, body, carry)
+        state = (cell, t_max, t_cur)
+        found = pending & jnp.isfinite(hit)
+        if exact:
+            t_ex, rough = exact_test(h_ci, h_t0, h_t1)
+            rough = rough | h_rough
+            last = r == rounds - 1
+            accept = found & (rough | jnp.isfinite(t_ex) | last)  # the last round keeps a sub-box hit
+            value = jnp.where(rough | ~jnp.isfinite(t_ex), hit, t_ex)
+        else:
+            accept, value = found, hit
+        result = jnp.where(accept, value, result)
+        pending = found & ~accept
+    hit = jnp.where(result <= limit, result, inf)
     return jnp.where(jnp.isinf(hit) & jnp.isfinite(t_floor) & (t_floor <= max_dist), t_floor, hit)
 
 
