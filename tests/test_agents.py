@@ -1,0 +1,132 @@
+"""The built-in agents on the shared small benchmark: the privileged upper
+bound far above chance, the cost-aware agent asking less as its charged
+costs rise and beating the free asker on WSR, determinism of the asking
+agents, and privileged information reaching only the privileged agent.
+
+Every rollout uses the whole 40-episode set as one batch (one compiled
+shape per agent) with the per-episode keys of :func:`ignjax.rollout.episode_keys`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import chex
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from ignjax import metrics as M
+from ignjax.agents.base import Agent, get_agent, registry
+from ignjax.evaluation import run_agent
+from ignjax.rollout import Privileged, episode_keys, pad_specs, rollout, rollout_episode, rollout_sweep
+from ignjax.sim import types as T
+
+SEED = 0
+SCALES = (0.25, 1.0, 4.0)  # the EIG agent's charged costs: locked costs x these
+
+
+def _batch(es):
+    """Specs and keys of every episode, as one batch (padded rows would be masked out)."""
+    n = len(es)
+    return pad_specs(es.specs, n), episode_keys(SEED, np.arange(n))
+
+
+def _outcomes(out) -> M.Outcomes:
+    return M.Outcomes.from_numpy(final_distance=out.final_distance, min_distance=out.min_distance,
+                                 path_length=out.path_length, stopped=out.stopped, n_questions=out.n_questions,
+                                 difficulty=out.difficulty, valid=out.valid)
+
+
+def _row(out) -> dict:
+    return M.metric_row(_outcomes(out))
+
+
+@pytest.fixture(scope="module")
+def runs(small_benchmark, small_world):
+    """Outcomes (numpy) of random, shortest_path and naive_asker, and the EIG
+    agent under three charged cost vectors in one vmapped call."""
+    es = small_benchmark["set"]
+    specs, keys = _batch(es)
+    res = {}
+    for name in ("random", "shortest_path", "naive_asker"):
+        agent = get_agent(name)
+        res[name] = jax.tree.map(np.asarray, rollout(small_world, specs, agent, agent.default_params(), keys))
+    eig = get_agent("eig")
+    base = eig.default_params()
+    K = len(SCALES)
+    params = jax.tree.map(lambda x: jnp.broadcast_to(x, (K,) + jnp.shape(x)), base)
+    costs = jnp.asarray(M.LOCKED_COSTS, jnp.float32)[None] * jnp.asarray(SCALES, jnp.float32)[:, None]
+    params = dataclasses.replace(params, costs=costs)
+    res["eig_sweep"] = jax.tree.map(np.asarray, rollout_sweep(small_world, specs, eig, params, keys))
+    res["eig_params"] = params
+    return res
+
+
+def _sweep_row(runs, k):
+    """(outcomes, trajectory) of row k of the EIG cost sweep."""
+    return jax.tree.map(lambda a: a[k], runs["eig_sweep"])
+
+
+def test_privileged_shortest_path_far_above_random(runs):
+    sp, rnd = _row(runs["shortest_path"][0]), _row(runs["random"][0])
+    assert sp["episodes"] == rnd["episodes"] == 40
+    assert sp["SR@1.5"] >= rnd["SR@1.5"] + 50, (sp["SR@1.5"], rnd["SR@1.5"])
+    assert sp["|Q|"] == 0 and rnd["|Q|"] == 0  # neither asks
+
+
+def test_eig_asks_less_as_charged_costs_rise(runs):
+    out, traj = runs["eig_sweep"]
+    q = np.asarray(out.n_questions).sum(-1).mean(-1)  # (K,) mean |Q| per episode
+    assert np.all(np.diff(q) <= 0), dict(zip(SCALES, q))
+    assert q[-1] < q[0], dict(zip(SCALES, q))
+    # every charged question is an ASK step of its type in the trajectory (refused ones are not charged)
+    asked = np.stack([((np.asarray(traj.kind) == T.ASK) & (np.asarray(traj.question) == t)).sum(-1)
+                      for t in range(1, 5)], -1)
+    assert np.all(asked >= np.asarray(out.n_questions))
+
+
+def test_eig_beats_naive_asker_on_wsr(runs):
+    eig = _row(_sweep_row(runs, SCALES.index(1.0))[0])  # the sweep's x1 row: the EIG agent at the locked costs
+    naive = _row(runs["naive_asker"][0])
+    assert eig["WSR@1.5"] > naive["WSR@1.5"], (eig["WSR@1.5"], naive["WSR@1.5"])
+
+
+def test_asking_agents_are_deterministic(small_benchmark, small_world, runs):
+    """Same keys, same outcomes and trajectories: again through the same
+    compiled call, and through :func:`run_agent` (same batch shape, so no
+    new compile); other keys give other trajectories."""
+    es = small_benchmark["set"]
+    specs, keys = _batch(es)
+    eig = get_agent("eig")
+    again = jax.tree.map(np.asarray, rollout_sweep(small_world, specs, eig, runs["eig_params"], keys))
+    chex.assert_trees_all_equal(again, runs["eig_sweep"])
+    naive = run_agent(es, "naive_asker", batch=len(es), seed=SEED, world=small_world)
+    chex.assert_trees_all_equal(naive, runs["naive_asker"])
+    other = run_agent(es, "naive_asker", batch=len(es), seed=SEED + 1, world=small_world)
+    assert not np.array_equal(other[1].pose, runs["naive_asker"][1].pose)
+
+
+def test_only_the_privileged_agent_receives_privileged_information(small_benchmark, small_world):
+    """The registry's flag, and what ``act`` is actually handed during a
+    rollout (traced with ``eval_shape``: no compile)."""
+    reg = registry()
+    assert {n for n, a in reg.items() if a.privileged} == {"shortest_path"}
+    es = small_benchmark["set"]
+    spec = jax.tree.map(lambda a: a[0], es.specs)
+    for name, agent in reg.items():
+        seen = []
+
+        def act(params, obs, answers, pstate, key, priv, _act=agent.act, _seen=seen):
+            _seen.append(priv)
+            return _act(params, obs, answers, pstate, key, priv)
+
+        spy = Agent(name, agent.init, act, agent.default_params, agent.privileged, agent.asks, agent.description)
+        jax.eval_shape(lambda k, spy=spy: rollout_episode(small_world, spec, spy, spy.default_params(), k)[:2],
+                       jax.random.key(0))
+        assert seen, name
+        if agent.privileged:
+            assert all(isinstance(p, Privileged) for p in seen), name
+        else:
+            assert all(p is None for p in seen), name
