@@ -109,21 +109,21 @@ def test_collision_rays_stop_motion_within_collision_distance(small_benchmark, s
 
 
 def test_forward_rays_agree_with_mujoco_at_collision_heights(small_benchmark, small_world):
-    """Horizontal collision rays (fixed-step march over the band map) against mj_ray.
+    """Horizontal collision rays (fixed-step march over the fine probe map) against mj_ray.
 
-    The march is conservative: it reports a hit at the first sample whose voxel
-    holds any geometry, so a ray grazing a surface may stop early, but only
-    where a real surface lies within about one voxel diagonal of the stopping
-    sample; it never runs through a surface (corner grazes below the sample
-    spacing aside); and leaving the grid (the house's exterior through an
-    outside door) counts as a wall.
+    Fine cells test the primitives grown sideways by a third of a fine cell,
+    so the march is slightly conservative: >= 98% of rays agree within one
+    navigation cell, a ray that stops early does so only where a real surface
+    lies within about one voxel diagonal of the stopping sample (a near miss
+    of a thin leg or a grazed wall), and at most 0.5% run past a surface
+    (corner grazes thinner than a fine cell).
     """
     from ignjax.sim.raycast import mj_rays
 
     es = small_benchmark["set"]
     bank = es.bank
     rays = bank.rays
-    step, rng_m = 0.025, 2.0
+    step, rng_m = bank.grid.resolution / E.FINE, 2.0
     rng = np.random.default_rng(1)
     n_h = len(small_world.config.collision_heights)
     f = jax.jit(jax.vmap(lambda w, xy, hd, z: jnp.stack([E.probe_free(w, jnp.int32(0), xy, hd, 1 << j, rng_m, step)
@@ -144,7 +144,7 @@ def test_forward_rays_agree_with_mujoco_at_collision_heights(small_benchmark, sm
     late = got > ref + step + 1e-3
     assert late.mean() <= 0.005, late.mean()
     agree = np.abs(got - ref) <= rays.resolution + step + 1e-4
-    assert agree.mean() >= 0.9, agree.mean()
+    assert agree.mean() >= 0.98, agree.mean()
 
     early = np.where(got < ref - rays.resolution - step - 1e-4)[0]
     stop = P[early] + V[early] * (got[early] + step)[:, None]  # the first occupied sample
@@ -152,9 +152,8 @@ def test_forward_rays_agree_with_mujoco_at_collision_heights(small_benchmark, sm
     w, h, _ = np.asarray(rays.dims[0])
     outside = (stop[:, 0] < ox) | (stop[:, 1] < oy) | (stop[:, 0] >= ox + w * rays.resolution) | \
               (stop[:, 1] >= oy + h * rays.resolution)
-    # leaving the grid: MuJoCo sees nothing up to the grid's edge
-    assert np.all(ref[early[outside]] >= got[early[outside]])
-    inside = stop[~outside]
+    assert not outside.any()  # beyond the grid is open space, as mj_ray sees it
+    inside = stop
     dirs = np.array([d for d in np.ndindex(3, 3, 3) if d != (1, 1, 1)], float) - 1
     dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
     near, _ = mj_rays(bank.compiled[0], np.repeat(inside, len(dirs), 0), np.tile(dirs, (len(inside), 1)), geomgroup=groups)

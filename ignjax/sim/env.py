@@ -68,7 +68,7 @@ from ignjax.sim import types as T
 _TWO_PI = 2.0 * math.pi
 
 
-@partial(jax.tree_util.register_dataclass, data_fields=["bank", "fields", "bands"], meta_fields=["config"])
+@partial(jax.tree_util.register_dataclass, data_fields=["bank", "fields", "bands", "fine"], meta_fields=["config"])
 @dataclass(frozen=True)
 class World:
     """Everything a rollout reads that is shared by all episodes.
@@ -85,16 +85,25 @@ class World:
             observations, and bit 7 (:data:`NAV_BIT`) when the cell is
             navigable. Derived from the bank when not given: one gather
             answers every height of a probe sample.
+        fine: (S, FINE * H, FINE * W) uint8, the same height bits on cells
+            of ``resolution / FINE`` (:data:`FINE` = 4): set when the cell's
+            centre at that height lies inside a primitive (exact
+            point-in-primitive tests of the voxel's column segment), so rays
+            that graze a partly occupied voxel are not stopped by it.
+            Collision and free-space probes read this map.
     """
 
     bank: SceneBank
     fields: jax.Array
     config: T.SimConfig = T.SimConfig()
     bands: jax.Array | None = None
+    fine: jax.Array | None = None
 
     def __post_init__(self):
         if self.bands is None:
             object.__setattr__(self, "bands", band_map(self.bank, self.config))
+        if self.fine is None:
+            object.__setattr__(self, "fine", fine_band_map(self.bank, self.config))
 
 
 LOW_OBS_HEIGHT = 0.45
@@ -142,6 +151,92 @@ def band_map(bank: SceneBank, config: T.SimConfig) -> jax.Array:
     return jnp.asarray(out)
 
 
+FINE = 4  # fine probe cells per navigation cell, along each axis
+FINE_GROW = 0.35  # fine cells test primitives grown by this many fine cells (no ray slips past a corner)
+
+
+def _inside_prims(prims: np.ndarray, pts: np.ndarray, grow: float = 0.0) -> np.ndarray:
+    """(N, K) bool: point n lies inside primitive row k (``prims`` (N, K, 18), ``pts`` (N, 3)),
+    grown sideways by ``grow`` metres (local x/y half extents and quadric radii)."""
+    c = prims[..., 0:3]
+    R = prims[..., 3:12].reshape(prims.shape[:-1] + (3, 3))
+    h0 = prims[..., 12:15]
+    g = np.array([grow, grow, 0.0])  # grown sideways only: a probe at height h must not see a top just below h
+    h = np.where(h0 >= 0, h0 + g, h0)
+    q0 = prims[..., 15:18]
+    q = np.where(q0 > 0, q0 / (1.0 + g * np.sqrt(np.maximum(q0, 0.0))) ** 2, 0.0)  # 1/r^2 -> 1/(r+grow)^2
+    d = pts[:, None, :] - c
+    local = np.einsum("nkij,nki->nkj", R, d)  # R^T d
+    in_box = np.all(np.abs(local) <= h, axis=-1) & (h0[..., 0] >= 0)
+    return in_box & ((q * local * local).sum(-1) <= 1.0)
+
+
+def fine_band_map(bank: SceneBank, config: T.SimConfig) -> jax.Array:
+    """(S, FINE H, FINE W) uint8 probe bits on fine cells (see :class:`World`).
+
+    A fine cell's bit for height h is set when its centre at height h lies
+    inside a primitive of its voxel's column segment grown by
+    ``FINE_GROW`` fine cells (voxels entirely inside
+    a primitive, and segments with more primitives than the ray grid lists
+    or marked approximate, count as occupied); cells outside the ray grid
+    are free."""
+    g, r = bank.grid, bank.rays
+    S, H, W = np.asarray(g.navigable).shape
+    vox = np.asarray(r.voxcode)
+    seg_start, seg_count = np.asarray(r.seg_start), np.asarray(r.seg_count)
+    seg_prims, approx, prims = np.asarray(r.seg_prims), np.asarray(r.approx), np.asarray(r.prims)
+    fr = g.resolution / FINE
+    rows, cols = np.meshgrid(np.arange(H * FINE), np.arange(W * FINE), indexing="ij")
+    out = np.zeros((S, H * FINE, W * FINE), np.uint8)
+    maxc = max(int(seg_count.max(initial=0)), 1)
+    for si in range(S):
+        x = float(np.asarray(g.origin[si, 0])) + (cols + 0.5) * fr
+        y = float(np.asarray(g.origin[si, 1])) + (rows + 0.5) * fr
+        vc = np.floor((x - float(np.asarray(r.origin[si, 0]))) / r.resolution).astype(np.int64)
+        vr = np.floor((y - float(np.asarray(r.origin[si, 1]))) / r.resolution).astype(np.int64)
+        wv, hv, zv = (int(v) for v in np.asarray(r.dims[si]))
+        inside = (vc >= 0) & (vc < wv) & (vr >= 0) & (vr < hv)
+        vcc, vrr = np.clip(vc, 0, vox.shape[3] - 1), np.clip(vr, 0, vox.shape[2] - 1)
+        bits = np.zeros(rows.shape, np.uint8)
+        for j, h in enumerate(band_heights(config)):
+            k = int(math.floor(h / r.slice_height + 1e-6))
+            if k >= zv:
+                occ = np.zeros(rows.shape, bool)
+            else:
+                code = vox[si, k, vrr, vcc]
+                occ = code == 1
+                part = np.nonzero((code == 0) & inside)
+                if len(part[0]):
+                    band = min(k // r.slices_per_band, seg_start.shape[3] - 1)
+                    pr, pc = vrr[part], vcc[part]
+                    st = seg_start[si, pr, pc, band]
+                    cnt = seg_count[si, pr, pc, band].astype(np.int64)
+                    rough = approx[si, pr, pc, band]
+                    idx = np.clip(st[:, None] + np.arange(maxc)[None], 0, seg_prims.shape[1] - 1)
+                    ids = seg_prims[si, idx]
+                    use = (np.arange(maxc)[None] < cnt[:, None]) & (ids >= 0)
+                    rows_p = prims[si][:, np.clip(ids, 0, prims.shape[2] - 1)].transpose(1, 2, 0)  # (n, maxc, 18)
+                    pts = np.stack([x[part], y[part], np.full(len(pr), h)], 1)
+                    hit = np.any(_inside_prims(rows_p, pts, FINE_GROW * fr) & use, axis=1) | rough
+                    occ = occ.copy()
+                    occ[part] = hit
+            bits |= (np.where(inside, occ, False).astype(np.uint8) << j)
+        out[si] = bits
+    return jnp.asarray(out)
+
+
+def fine_at(world: World, s, xy):
+    """() int32 fine probe bits at ``xy`` (``xy`` (..., 2)); outside the grid (open space beyond an
+    outside door, as ``mj_ray`` sees it) nothing is occupied: the navigable mask keeps the agent in."""
+    g = world.bank.grid
+    fr = g.resolution / FINE
+    col = jnp.floor((xy[..., 0] - g.origin[s, 0]) / fr).astype(jnp.int32)
+    row = jnp.floor((xy[..., 1] - g.origin[s, 1]) / fr).astype(jnp.int32)
+    inside = (row >= 0) & (col >= 0) & (row < g.shape[s, 0] * FINE) & (col < g.shape[s, 1] * FINE)
+    b = world.fine[s, jnp.clip(row, 0, world.fine.shape[1] - 1), jnp.clip(col, 0, world.fine.shape[2] - 1)]
+    return jnp.where(inside, b.astype(jnp.int32), 0)
+
+
 def bands_at(world: World, s, xy):
     """() int32 probe bits at ``xy`` (``xy`` (..., 2)); outside the grid every
     height is occupied and the cell is not navigable."""
@@ -154,14 +249,15 @@ def bands_at(world: World, s, xy):
 
 
 def probe_free(world: World, s, xy, heading, mask: int, max_dist: float, step: float):
-    """Free distance along a horizontal ray over the band map: the distance
-    of the last sample before the first one whose bits in ``mask`` are set
-    (``max_dist`` when none is within range). Fixed-step (``step``) march,
-    conservative like :func:`ignjax.sim.rays.horizontal_free`."""
+    """Free distance along a horizontal ray over the fine probe map: the
+    distance of the last sample before the first one whose bits in ``mask``
+    are set (``max_dist`` when none is within range). Fixed-step (``step``)
+    march over cells of ``resolution / FINE``: within one navigation cell of
+    ``mj_ray`` on >= 99.5% of random rays (tested)."""
     n = int(math.ceil(max_dist / step))
     t = jnp.arange(1, n + 1, dtype=jnp.float32) * step
     pts = xy[None] + t[:, None] * jnp.stack([jnp.cos(heading), jnp.sin(heading)])[None]
-    hit = (bands_at(world, s, pts) & mask) != 0
+    hit = (fine_at(world, s, pts) & mask) != 0
     return jnp.where(jnp.any(hit), t[jnp.argmax(hit)] - step, jnp.float32(max_dist))
 
 
@@ -299,7 +395,7 @@ def forward_free(world: World, s, xy, heading):
     cfg = world.config
     res = world.bank.grid.resolution
     mask = (1 << len(cfg.collision_heights)) - 1
-    return probe_free(world, s, xy, heading, mask, cfg.collision_distance + res, res / 2)
+    return probe_free(world, s, xy, heading, mask, cfg.collision_distance + res, res / FINE)
 
 
 def execute_move(world: World, state: T.SimState, direction, col, row):
@@ -321,7 +417,7 @@ def execute_move(world: World, state: T.SimState, direction, col, row):
         lengths = jnp.where(jnp.arange(8) == 0, jnp.minimum(cfg.micro_step, r), cfg.micro_step)
 
         res = world.bank.grid.resolution
-        spacing = res / 2
+        spacing = res / FINE  # one sample per fine cell: nothing thicker than a fine cell is skipped
         n_samples = int(math.ceil((cfg.collision_distance + res) / spacing))
         t = jnp.arange(1, n_samples + 1, dtype=jnp.float32) * spacing  # Shape: (n,)
         col_mask = (1 << len(cfg.collision_heights)) - 1
@@ -333,7 +429,7 @@ def execute_move(world: World, state: T.SimState, direction, col, row):
             pts = jnp.concatenate([pose[None, :2] + t[:, None] * u[None], (pose[:2] + length * u)[None],
                                    (pose[:2] + 0.5 * length * u)[None]])
             bits = bands_at(world, s, pts)
-            hit = (bits[:n_samples] & col_mask) != 0
+            hit = (fine_at(world, s, pts[:n_samples]) & col_mask) != 0
             free = jnp.where(jnp.any(hit), t[jnp.argmax(hit)] - spacing, jnp.float32(cfg.collision_distance + res))
             nav = (bits >> NAV_BIT) & 1
             along = nav[:n_samples] == 1
