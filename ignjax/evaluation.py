@@ -24,6 +24,26 @@ def make_world(es: EpisodeSet, config: SimConfig = SimConfig()) -> World:
     return World(es.bank, es.fields, config)
 
 
+def episode_batches(es: EpisodeSet, batch: int, seed: int = 0, progress=None):
+    """Yield ``(n_real, specs, keys)`` for consecutive chunks of ``batch``
+    episodes of ``es``: the last chunk padded with masked copies so every
+    chunk has the same shape (one compiled rollout), and each episode's key
+    from the seed and its index in the file (:func:`ignjax.rollout.episode_keys`).
+    ``progress`` optionally wraps the iterable of chunk starts (a progress bar)."""
+    n = len(es)
+    batch = max(1, min(int(batch), n))
+    keys_all = episode_keys(seed, np.arange(n))
+    starts = list(range(0, n, batch))
+    for start in (progress(starts) if progress else starts):
+        idx = np.arange(start, min(start + batch, n))
+        specs = jax.tree.map(lambda a: a[idx], es.specs)
+        keys = keys_all[idx]
+        if len(idx) < batch:
+            specs = pad_specs(specs, batch)
+            keys = jax.numpy.concatenate([keys, jax.numpy.repeat(keys[-1:], batch - len(idx))])
+        yield len(idx), specs, keys
+
+
 def run_agent(es: EpisodeSet, agent: Agent | str, *, params=None, batch: int = 256, seed: int = 0,
               config: SimConfig = SimConfig(), progress=None, world: World | None = None):
     """Roll out every episode of ``es`` with one agent.
@@ -35,21 +55,11 @@ def run_agent(es: EpisodeSet, agent: Agent | str, *, params=None, batch: int = 2
     params = agent.default_params() if params is None else params
     world = world or make_world(es, config)
     check_specs(world, es.specs)
-    n = len(es)
-    batch = max(1, min(int(batch), n))
-    keys_all = episode_keys(seed, np.arange(n))
     outs = []
-    chunks = list(range(0, n, batch))
-    for start in (progress(chunks) if progress else chunks):
-        idx = np.arange(start, min(start + batch, n))
-        specs = jax.tree.map(lambda a: a[idx], es.specs)
-        keys = keys_all[idx]
-        if len(idx) < batch:
-            specs = pad_specs(specs, batch)
-            keys = jax.numpy.concatenate([keys, jax.numpy.repeat(keys[-1:], batch - len(idx))])
+    for n_real, specs, keys in episode_batches(es, batch, seed, progress):
         out, traj = rollout(world, specs, agent, params, keys)
-        outs.append(jax.tree.map(lambda a, m=len(idx): np.asarray(a)[:m], (out, traj)))
+        outs.append(jax.tree.map(lambda a, m=n_real: np.asarray(a)[:m], (out, traj)))
     return jax.tree.map(lambda *xs: np.concatenate(xs), *outs)
 
 
-__all__ = ["make_world", "run_agent"]
+__all__ = ["episode_batches", "make_world", "run_agent"]

@@ -39,6 +39,7 @@ import numpy as np
 from ignjax import metrics as M
 from ignjax.episodes.difficulty import BIN_INDEX, BIN_NAMES
 from ignjax.errors import InputError
+from ignjax.fileio import atomic_write
 from ignjax.sim.types import STOP_REASONS
 
 COLUMNS: tuple[str, ...] = (
@@ -97,13 +98,6 @@ def _arrow_table(rows: list[dict]):
     return pa.Table.from_pylist(rows, schema=schema)
 
 
-def _atomic_write(path: Path, data: bytes) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
-    tmp.write_bytes(data)
-    os.replace(tmp, path)
-
-
 def write_outcomes(rows: list[dict], folder: str | os.PathLike, name: str = "outcomes") -> tuple[Path, Path]:
     """Write ``name.parquet`` and ``name.csv`` atomically. Returns both paths."""
     import pyarrow.parquet as pq
@@ -113,14 +107,14 @@ def write_outcomes(rows: list[dict], folder: str | os.PathLike, name: str = "out
     buf = io.BytesIO()
     pq.write_table(table, buf)
     p_parquet = folder / f"{name}.parquet"
-    _atomic_write(p_parquet, buf.getvalue())
+    atomic_write(p_parquet, buf.getvalue())
     text = io.StringIO()
     w = csv.DictWriter(text, fieldnames=list(COLUMNS), lineterminator="\n")
     w.writeheader()
     for r in rows:
         w.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in r.items()})
     p_csv = folder / f"{name}.csv"
-    _atomic_write(p_csv, text.getvalue().encode())
+    atomic_write(p_csv, text.getvalue().encode())
     return p_parquet, p_csv
 
 
@@ -198,7 +192,7 @@ def write_metric_table(metrics: dict[str, dict], path: str | os.PathLike) -> Pat
     w.writeheader()
     for agent, m in metrics.items():
         w.writerow({"agent": agent, **{k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in m.items()}})
-    _atomic_write(p, text.getvalue().encode())
+    atomic_write(p, text.getvalue().encode())
     return p
 
 

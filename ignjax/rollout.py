@@ -18,7 +18,6 @@ trajectory plots and the interaction analyses.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from functools import partial
 

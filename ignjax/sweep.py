@@ -44,6 +44,7 @@ from pathlib import Path
 import numpy as np
 
 from ignjax.errors import ConfigError, IgnjaxError, InputError
+from ignjax.fileio import atomic_write
 from ignjax.sweep_config import STUDIES, fingerprint, resolve
 
 REPO_SCENES = Path(__file__).resolve().parent.parent / "scenes"
@@ -128,14 +129,8 @@ def prepare_folder(out: Path, cfg: dict, studies: list[str], resume: bool, force
                                                     "it or --force to start over")
     out.mkdir(parents=True, exist_ok=True)
     if not meta.is_file():
-        _write_text(meta, json.dumps({"fingerprint": fp, "studies": studies, "config": cfg}, indent=2, sort_keys=True)
+        atomic_write(meta, json.dumps({"fingerprint": fp, "studies": studies, "config": cfg}, indent=2, sort_keys=True)
                     + "\n")
-
-
-def _write_text(path: Path, text: str) -> None:
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
 
 
 class Checkpoints:
@@ -275,7 +270,8 @@ def run_costs_stage(es, world, cfg: dict, ckpt: Checkpoints, bar=None) -> dict:
     import jax.numpy as jnp
 
     from ignjax.agents.base import get_agent
-    from ignjax.rollout import episode_keys, pad_specs, rollout_sweep
+    from ignjax.evaluation import episode_batches
+    from ignjax.rollout import rollout_sweep
 
     agent = get_agent(cfg["costs"]["agent"])
     base = agent.default_params()
@@ -284,21 +280,13 @@ def run_costs_stage(es, world, cfg: dict, ckpt: Checkpoints, bar=None) -> dict:
     K = len(costs)
     params = jax.tree.map(lambda x: jnp.broadcast_to(x, (K,) + jnp.shape(x)), base)
     params = dataclasses.replace(params, costs=jnp.asarray(costs, jnp.float32))
-    n = len(es)
-    batch = max(1, min(cfg["eval"]["batch"] // max(1, K // 4), n))
-    keys_all = episode_keys(cfg["run"]["seed"], np.arange(n))
+    batch = max(1, cfg["eval"]["batch"] // max(1, K // 4))
     parts = []
-    for start in range(0, n, batch):
-        idx = np.arange(start, min(start + batch, n))
-        specs = jax.tree.map(lambda a: a[idx], es.specs)
-        keys = keys_all[idx]
-        if len(idx) < batch:
-            specs = pad_specs(specs, batch)
-            keys = jnp.concatenate([keys, jnp.repeat(keys[-1:], batch - len(idx))])
+    for n_real, specs, keys in episode_batches(es, batch, cfg["run"]["seed"]):
         out, _ = rollout_sweep(world, specs, agent, params, keys)
-        parts.append({k: v[:, :len(idx)] for k, v in _to_tree(out).items()})
+        parts.append({k: v[:, :n_real] for k, v in _to_tree(out).items()})
         if bar is not None:
-            bar.update(len(idx) * K)
+            bar.update(n_real * K)
     tree = {"out": {k: np.concatenate([p[k] for p in parts], axis=1) for k in parts[0]}, "costs": costs}
     ckpt.save(name, tree)
     return tree

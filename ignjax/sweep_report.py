@@ -18,16 +18,9 @@ import numpy as np
 
 from ignjax import metrics as M
 from ignjax.episodes.difficulty import BIN_INDEX, BIN_NAMES
+from ignjax.fileio import atomic_write
 
 FACTOR_NAMES = ("F_distractor", "F_room", "F_context", "F_start")
-
-
-def _write(path: Path, data: str | bytes) -> Path:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_bytes(data.encode() if isinstance(data, str) else data)
-    tmp.replace(path)
-    return path
 
 
 def _fmt(v) -> str:
@@ -42,7 +35,7 @@ def write_csv(path: Path, header: list[str], rows: list[list]) -> Path:
     w.writerow(header)
     for r in rows:
         w.writerow([_fmt(v) for v in r])
-    return _write(path, buf.getvalue())
+    return atomic_write(path, buf.getvalue())
 
 
 def md_table(header: list[str], rows: list[list]) -> str:
@@ -262,6 +255,8 @@ def plot_trajectories(es, tree: dict, n: int, folder: Path, agent: str) -> list[
     """Top-down plots of a few episodes (one per difficulty first, then in
     file order): start, path, target, distractors and where each question
     type was asked."""
+    import matplotlib.pyplot as plt
+
     from ignjax.scenes.mapplot import plot_scene_map, save_figure
 
     if n <= 0:
@@ -304,8 +299,6 @@ def plot_trajectories(es, tree: dict, n: int, folder: Path, agent: str) -> list[
         ax.set_ylabel("y (m)")
         path = folder / f"trajectory_{len(paths)}.png"
         save_figure(fig, path)
-        import matplotlib.pyplot as plt
-
         plt.close(fig)
         paths.append(path)
     return paths
@@ -360,7 +353,7 @@ def write_outputs(results: dict, out: Path) -> None:
     if "difficulty" in studies:
         ds = study_difficulty(es, rollouts, cfg, out)
         results["difficulty"] = ds
-        abl, cal = ds["ablation"], ds["calibration"]
+        abl = ds["ablation"]
         p = ds["default_proportions"]
         parts += ["## Difficulty-coefficient ablation", "",
                   f"{len(abl['alphas'])} alpha settings on the simplex x {len(abl['thresholds'])} threshold pairs "
@@ -395,7 +388,7 @@ def write_outputs(results: dict, out: Path) -> None:
                   "![Delta-U](figures/analysis_delta_u.png)", ""]
         for p in an["trajectory_plots"]:
             parts += [f"![trajectory]({p.relative_to(out).as_posix()})", ""]
-    _write(out / "report.md", "\n".join(parts))
+    atomic_write(out / "report.md", "\n".join(parts))
 
 
 __all__ = ["agent_arrays", "factors_of", "md_table", "plot_trajectories", "study_analysis", "study_costs",

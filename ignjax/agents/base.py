@@ -69,12 +69,13 @@ class Agent:
     description: str = ""
 
 
-def _register(cls):
+def pytree_dataclass(cls):
+    """Register a (frozen) dataclass as a pytree whose every field is data."""
     names = [f.name for f in dataclasses.fields(cls)]
     return partial(jax.tree_util.register_dataclass, data_fields=names, meta_fields=[])(cls)
 
 
-@_register
+@pytree_dataclass
 @dataclass(frozen=True)
 class Memory:
     """Scripted agents' memory (one episode).

@@ -57,28 +57,21 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from functools import partial
 from types import MappingProxyType
 
 import jax
 import jax.numpy as jnp
 
 from ignjax.agents.base import (
-    Agent, Memory, candidate_relative, explore_direction, move_toward, observe_memory,
+    Agent, Memory, candidate_relative, explore_direction, move_toward, observe_memory, pytree_dataclass,
 )
 from ignjax.metrics import LOCKED_COSTS
 from ignjax.scenes import vocab
 from ignjax.sim import types as T
-from ignjax.sim.geometry import wrap_angle
 
 DEADLINE_STEPS = 4  # belief agents commit to their best seen candidate this many steps before the end
 N_COLORS = len(vocab.COLORS)
 N_ROOM_LABELS = len(vocab.ALL_ROOM_LABELS)
-
-
-def _pytree(cls):
-    names = [f.name for f in dataclasses.fields(cls)]
-    return partial(jax.tree_util.register_dataclass, data_fields=names, meta_fields=[])(cls)
 
 
 # ---------------------------------------------------------------------------
@@ -86,7 +79,7 @@ def _pytree(cls):
 # ---------------------------------------------------------------------------
 
 
-@_pytree
+@pytree_dataclass
 @dataclass(frozen=True)
 class RandomParams:
     """stop_prob: () probability of STOP at each decision."""
@@ -115,7 +108,7 @@ RANDOM = Agent("random", _random_init, _random_act, lambda: RandomParams(jnp.flo
 # ---------------------------------------------------------------------------
 
 
-@_pytree
+@pytree_dataclass
 @dataclass(frozen=True)
 class PathParams:
     """stop_distance: () stop when the geodesic distance is below this, m."""
@@ -138,7 +131,7 @@ SHORTEST_PATH = Agent("shortest_path", _random_init, _path_act, lambda: PathPara
 # ---------------------------------------------------------------------------
 
 
-@_pytree
+@pytree_dataclass
 @dataclass(frozen=True)
 class BeliefParams:
     """Parameters of the belief-based agents.

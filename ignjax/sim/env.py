@@ -60,7 +60,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ignjax.errors import ConfigError
-from ignjax.scenes.bank import SceneBank, field_at
+from ignjax.scenes.bank import SceneBank
 from ignjax.sim import geometry as G
 from ignjax.sim import rays as SR
 from ignjax.sim import types as T
@@ -68,7 +68,7 @@ from ignjax.sim import types as T
 _TWO_PI = 2.0 * math.pi
 
 
-@partial(jax.tree_util.register_dataclass, data_fields=["bank", "fields", "bands", "fine"], meta_fields=["config"])
+@partial(jax.tree_util.register_dataclass, data_fields=["bank", "fields", "fine"], meta_fields=["config"])
 @dataclass(frozen=True)
 class World:
     """Everything a rollout reads that is shared by all episodes.
@@ -78,77 +78,39 @@ class World:
         fields: (F, H, W) float32 geodesic fields of the episodes' targets
             (on the bank's padded grid); episodes index them by ``field``.
         config: static simulator configuration.
-        bands: (S, H, W) uint8 per navigation cell, one bit per probe height
-            (:data:`BAND_BITS`): bit j < len(collision_heights) is set when
-            the voxel column is occupied at ``collision_heights[j]``, then
-            the eye height and :data:`LOW_OBS_HEIGHT` for free-space
-            observations, and bit 7 (:data:`NAV_BIT`) when the cell is
-            navigable. Derived from the bank when not given: one gather
-            answers every height of a probe sample.
-        fine: (S, FINE * H, FINE * W) uint8, the same height bits on cells
-            of ``resolution / FINE`` (:data:`FINE` = 4): set when the cell's
-            centre at that height lies inside a primitive (exact
-            point-in-primitive tests of the voxel's column segment), so rays
-            that graze a partly occupied voxel are not stopped by it.
-            Collision and free-space probes read this map.
+        fine: (S, FINE * H, FINE * W) uint8 probe map on cells of
+            ``resolution / FINE`` (:data:`FINE` = 4), one bit per probe
+            height (:func:`probe_heights`: the collision heights, then the
+            eye height and :data:`LOW_OBS_HEIGHT` for free-space
+            observations), set when the cell's centre at that height lies
+            inside a primitive (exact point-in-primitive tests of the
+            voxel's column segment), so rays that graze a partly occupied
+            voxel are not stopped by it; one gather answers every height of
+            a probe sample. Derived from the bank when not given.
     """
 
     bank: SceneBank
     fields: jax.Array
     config: T.SimConfig = T.SimConfig()
-    bands: jax.Array | None = None
     fine: jax.Array | None = None
 
     def __post_init__(self):
-        if self.bands is None:
-            object.__setattr__(self, "bands", band_map(self.bank, self.config))
         if self.fine is None:
-            object.__setattr__(self, "fine", fine_band_map(self.bank, self.config))
+            object.__setattr__(self, "fine", probe_map(self.bank, self.config))
 
 
 LOW_OBS_HEIGHT = 0.45
 DEPTH_ELEVATION = math.radians(55.0)  # steepest pixel ray followed to the full waypoint range
 DEPTH_EXACT_PRIMS = 8  # primitives tested exactly per occupied voxel by the depth ray
 DEPTH_ITERATIONS = 64  # traversal steps of the depth ray (free space is crossed several voxels at a time)
-NAV_BIT = 7
 
 
-def band_heights(config: T.SimConfig) -> tuple[float, ...]:
-    """Heights of the bits of :attr:`World.bands` (collision heights, eye height, low observation height)."""
+def probe_heights(config: T.SimConfig) -> tuple[float, ...]:
+    """Heights of the bits of :attr:`World.fine` (collision heights, eye height, low observation height)."""
     hs = tuple(config.collision_heights) + (config.eye_height, LOW_OBS_HEIGHT)
-    if len(hs) > NAV_BIT:
-        raise ConfigError(f"collision_heights: at most {NAV_BIT - 2} heights are supported, got {len(hs) - 2}")
+    if len(hs) > 8:
+        raise ConfigError(None, "collision_heights", f"at most 6 heights are supported, got {len(hs) - 2}")
     return hs
-
-
-def band_map(bank: SceneBank, config: T.SimConfig) -> jax.Array:
-    """(S, H, W) uint8 probe bits of every navigation cell (see :class:`World`).
-
-    A cell's bit for height h is set when the ray grid's voxel under the
-    cell's centre at slice ``floor(h / slice_height)`` is occupied
-    (``voxcode <= 1``); cells outside the ray grid count as occupied."""
-    g, r = bank.grid, bank.rays
-    nav = np.asarray(g.navigable)
-    S, H, W = nav.shape
-    vox = np.asarray(r.voxcode)
-    rows, cols = np.meshgrid(np.arange(H), np.arange(W), indexing="ij")
-    out = np.zeros((S, H, W), np.uint8)
-    for si in range(S):
-        cx = np.asarray(g.origin[si, 0]) + (cols + 0.5) * g.resolution
-        cy = np.asarray(g.origin[si, 1]) + (rows + 0.5) * g.resolution
-        vc = np.floor((cx - np.asarray(r.origin[si, 0])) / r.resolution).astype(np.int64)
-        vr = np.floor((cy - np.asarray(r.origin[si, 1])) / r.resolution).astype(np.int64)
-        wv, hv, zv = (int(v) for v in np.asarray(r.dims[si]))
-        inside = (vc >= 0) & (vc < wv) & (vr >= 0) & (vr < hv)
-        vcc, vrr = np.clip(vc, 0, vox.shape[3] - 1), np.clip(vr, 0, vox.shape[2] - 1)
-        bits = np.zeros((H, W), np.uint8)
-        for j, h in enumerate(band_heights(config)):
-            k = int(math.floor(h / r.slice_height + 1e-6))
-            occ = (vox[si, min(k, vox.shape[1] - 1), vrr, vcc] <= SR._OCCUPIED_MAX_CODE) if k < zv else np.zeros((H, W), bool)
-            bits |= (np.where(inside, occ, True).astype(np.uint8) << j)
-        bits |= (nav[si].astype(np.uint8) << NAV_BIT)
-        out[si] = bits
-    return jnp.asarray(out)
 
 
 FINE = 4  # fine probe cells per navigation cell, along each axis
@@ -171,7 +133,7 @@ def _inside_prims(prims: np.ndarray, pts: np.ndarray, grow: float = 0.0) -> np.n
     return in_box & ((q * local * local).sum(-1) <= 1.0)
 
 
-def fine_band_map(bank: SceneBank, config: T.SimConfig) -> jax.Array:
+def probe_map(bank: SceneBank, config: T.SimConfig) -> jax.Array:
     """(S, FINE H, FINE W) uint8 probe bits on fine cells (see :class:`World`).
 
     A fine cell's bit for height h is set when its centre at height h lies
@@ -198,7 +160,7 @@ def fine_band_map(bank: SceneBank, config: T.SimConfig) -> jax.Array:
         inside = (vc >= 0) & (vc < wv) & (vr >= 0) & (vr < hv)
         vcc, vrr = np.clip(vc, 0, vox.shape[3] - 1), np.clip(vr, 0, vox.shape[2] - 1)
         bits = np.zeros(rows.shape, np.uint8)
-        for j, h in enumerate(band_heights(config)):
+        for j, h in enumerate(probe_heights(config)):
             k = int(math.floor(h / r.slice_height + 1e-6))
             if k >= zv:
                 occ = np.zeros(rows.shape, bool)
@@ -237,17 +199,6 @@ def fine_at(world: World, s, xy):
     return jnp.where(inside, b.astype(jnp.int32), 0)
 
 
-def bands_at(world: World, s, xy):
-    """() int32 probe bits at ``xy`` (``xy`` (..., 2)); outside the grid every
-    height is occupied and the cell is not navigable."""
-    g = world.bank.grid
-    col = jnp.floor((xy[..., 0] - g.origin[s, 0]) / g.resolution).astype(jnp.int32)
-    row = jnp.floor((xy[..., 1] - g.origin[s, 1]) / g.resolution).astype(jnp.int32)
-    inside = (row >= 0) & (col >= 0) & (row < g.shape[s, 0]) & (col < g.shape[s, 1])
-    b = world.bands[s, jnp.clip(row, 0, world.bands.shape[1] - 1), jnp.clip(col, 0, world.bands.shape[2] - 1)]
-    return jnp.where(inside, b.astype(jnp.int32), (1 << NAV_BIT) - 1)
-
-
 def probe_free(world: World, s, xy, heading, mask: int, max_dist: float, step: float):
     """Free distance along a horizontal ray over the fine probe map: the
     distance of the last sample before the first one whose bits in ``mask``
@@ -268,13 +219,13 @@ def probe_free(world: World, s, xy, heading, mask: int, max_dist: float, step: f
 
 def _cell(world: World, s, xy):
     g = world.bank.grid
-    col = jnp.floor((xy[0] - g.origin[s, 0]) / g.resolution).astype(jnp.int32)
-    row = jnp.floor((xy[1] - g.origin[s, 1]) / g.resolution).astype(jnp.int32)
+    col = jnp.floor((xy[..., 0] - g.origin[s, 0]) / g.resolution).astype(jnp.int32)
+    row = jnp.floor((xy[..., 1] - g.origin[s, 1]) / g.resolution).astype(jnp.int32)
     return row, col
 
 
 def navigable_at(world: World, s, xy):
-    """() bool: the cell containing ``xy`` is navigable in scene ``s``."""
+    """(...) bool: the cell containing ``xy`` (..., 2) is navigable in scene ``s``."""
     g = world.bank.grid
     row, col = _cell(world, s, xy)
     inside = (row >= 0) & (col >= 0) & (row < g.shape[s, 0]) & (col < g.shape[s, 1])
@@ -391,7 +342,7 @@ def pixel_waypoint(world: World, s, pose, direction, col, row):
 
 
 def forward_free(world: World, s, xy, heading):
-    """() free distance ahead at the collision heights (all heights at once, band map)."""
+    """() free distance ahead at the collision heights (all heights at once, probe map)."""
     cfg = world.config
     res = world.bank.grid.resolution
     mask = (1 << len(cfg.collision_heights)) - 1
@@ -423,18 +374,18 @@ def execute_move(world: World, state: T.SimState, direction, col, row):
         col_mask = (1 << len(cfg.collision_heights)) - 1
 
         def probe(h, length):
-            # one march over the band map answers the collision rays at every height and the
-            # navigability of every cell along the step (no hopping over a thin gap into another component)
+            # one march over the probe map answers the collision rays at every height; the same samples
+            # check the navigability of every cell along the step (no hopping over a thin gap into
+            # another component)
             u = jnp.stack([jnp.cos(h), jnp.sin(h)])
             pts = jnp.concatenate([pose[None, :2] + t[:, None] * u[None], (pose[:2] + length * u)[None],
                                    (pose[:2] + 0.5 * length * u)[None]])
-            bits = bands_at(world, s, pts)
             hit = (fine_at(world, s, pts[:n_samples]) & col_mask) != 0
             free = jnp.where(jnp.any(hit), t[jnp.argmax(hit)] - spacing, jnp.float32(cfg.collision_distance + res))
-            nav = (bits >> NAV_BIT) & 1
-            along = nav[:n_samples] == 1
-            full = jnp.all(jnp.where(t <= length, along, True)) & (nav[n_samples] == 1)
-            half = jnp.all(jnp.where(t <= 0.5 * length, along, True)) & (nav[n_samples + 1] == 1)
+            nav = navigable_at(world, s, pts)
+            along = nav[:n_samples]
+            full = jnp.all(jnp.where(t <= length, along, True)) & nav[n_samples]
+            half = jnp.all(jnp.where(t <= 0.5 * length, along, True)) & nav[n_samples + 1]
             return free >= cfg.collision_distance, full, half
 
         ray_ok, full_ok, half_ok = jax.vmap(probe)(headings, lengths)
