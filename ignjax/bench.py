@@ -8,6 +8,9 @@ process, on the same inputs:
   (:func:`ignjax.sim.rays.march`, voxel traversal with exact primitive
   tests), ``mjx.ray`` (vmapped) and ``mujoco.mj_multiRay``; their
   agreement with ``mj_multiRay`` within one grid cell.
+* **probe rays** - agreement with ``mj_ray`` of the probe-map rays the
+  rollouts cast: collision rays at the controller's range, the same rays
+  over 2 m, and the observation's free-space rays.
 * **scene compile** - compiling that house and its navigation grids.
 * **decision steps/s** - full rollouts (simulation + agent + oracle +
   accounting, no rendering) on the shipped benchmark for each JAX-native
@@ -73,6 +76,50 @@ def bench_rays(quick: bool) -> dict:
         "ray_agreement": r["agreement"], "ray_agreement_depth_march": march_agree,
         "scene_compile_s": compile_s, "speedup_vs_mjx": r["speedup_vs_mjx"],
         "speedup_vs_multiray": r["speedup_vs_multiray"]}
+
+
+def bench_probe_rays(quick: bool) -> dict:
+    """Agreement with ``mj_ray`` (within one navigation cell plus one sample
+    step) of the probe-map rays the rollouts cast: the controller's collision
+    rays (collision heights, its range ``collision_distance`` + one cell), the
+    same rays over 2 m, and the observation's free-space rays (eye and low
+    height, ``obs_range``, steps of two cells)."""
+    import math
+
+    import jax
+    import jax.numpy as jnp
+
+    from ignjax.scenes.bank import SceneBank
+    from ignjax.scenes.procgen import HouseParams, generate_house
+    from ignjax.sim import env as E
+    from ignjax.sim.raycast import mj_rays
+    from ignjax.sim.types import SimConfig
+
+    bank = SceneBank.build([generate_house(3, HouseParams(n_rooms=10), "bench_house")])
+    cfg = SimConfig()
+    world = E.World(bank, jnp.zeros((1,) + tuple(bank.grid.navigable.shape[1:]), jnp.float32), cfg)
+    res = bank.grid.resolution
+    n_col = len(cfg.collision_heights)
+    rng = np.random.default_rng(0)
+    pts_all = bank.navgrids[0].navigable_points()
+    n = 4000 if quick else 20000
+    out = {}
+    cases = (("collision", cfg.collision_distance + res, res / E.FINE, tuple(cfg.collision_heights), 0),
+             ("collision_2m", 2.0, res / E.FINE, tuple(cfg.collision_heights), 0),
+             ("observation", cfg.obs_range, 2 * res, (cfg.eye_height, E.LOW_OBS_HEIGHT), n_col))
+    for name, rng_m, step, heights, bit0 in cases:
+        f = jax.jit(jax.vmap(lambda xy, hd, z: jnp.stack(
+            [E.probe_free(world, jnp.int32(0), xy, hd, 1 << (bit0 + j), rng_m, step) for j in range(len(heights))])[z]))
+        pts = pts_all[rng.integers(len(pts_all), size=n)]
+        hd = rng.uniform(-math.pi, math.pi, n)
+        zi = rng.integers(0, len(heights), n)
+        got = np.asarray(f(jnp.asarray(pts, jnp.float32), jnp.asarray(hd, jnp.float32), jnp.asarray(zi)))
+        P = np.c_[pts, np.asarray(heights)[zi]]
+        V = np.c_[np.cos(hd), np.sin(hd), np.zeros(n)]
+        ref, _ = mj_rays(bank.compiled[0], P, V, geomgroup=(0, 1, 1, 1, 0, 0))
+        ref = np.where(np.isfinite(ref) & (ref <= rng_m), ref, rng_m)
+        out[name] = float(np.mean(np.abs(got - ref) <= res + step + 1e-4))
+    return out
 
 
 def _timed(fn) -> float:
@@ -175,6 +222,9 @@ def main(argv=None) -> int:
          f"mj_multiRay {r['mj_multiray']:.3g}/s; fast/mjx = {r['fast'] / r['mjx']:.1f}x, "
          f"fast/mj_multiRay = {r['fast'] / r['mj_multiray']:.1f}x; agreement {res['ray_agreement']:.4f} "
          f"(march {res['ray_agreement_depth_march']:.4f}); 10-room house compile + grids {res['scene_compile_s']:.2f} s")
+    res["probe_ray_agreement"] = bench_probe_rays(args.quick)
+    _log("  probe-map rays within one cell of mj_ray: " + ", ".join(
+        f"{k} {v:.4f}" for k, v in res["probe_ray_agreement"].items()))
     es = load_benchmark(args.episodes or SHIPPED_BENCHMARK)
     world = make_world(es)
     _log("decision steps ...")

@@ -130,3 +130,73 @@ def test_only_the_privileged_agent_receives_privileged_information(small_benchma
             assert all(isinstance(p, Privileged) for p in seen), name
         else:
             assert all(p is None for p in seen), name
+
+
+def _reference_likelihoods(mem, obs):
+    """The EIG agent's answer models as explicit (A, hypotheses) likelihood
+    matrices (see :mod:`ignjax.agents.policies`), for one episode."""
+    import math
+
+    from ignjax.agents import policies as P
+
+    L_, C_ = P.N_ROOM_LABELS, P.N_COLORS
+    U = L_ * 8
+    valid = (mem.handle >= 0) & ~mem.rejected
+    col = mem.attrs[:, 0]
+    L1 = jnp.concatenate([jnp.where(col[None] >= 0, (jnp.arange(C_)[:, None] == col[None]).astype(jnp.float32), 1.0 / C_),
+                          jnp.full((C_, U), 1.0 / C_)], axis=1)
+    L2 = jnp.concatenate([jnp.where(mem.room[None] >= 0, (jnp.arange(L_)[:, None] == mem.room[None]).astype(jnp.float32),
+                                    1.0 / L_),
+                          (jnp.arange(L_)[:, None] == jnp.repeat(jnp.arange(L_), 8)[None]).astype(jnp.float32)], axis=1)
+    d = mem.pos - obs.odometry[None, :2]
+    dist = jnp.linalg.norm(d, axis=1)
+    bearing = jnp.arctan2(jnp.sin(jnp.arctan2(d[:, 1], d[:, 0]) - obs.heading), jnp.cos(jnp.arctan2(d[:, 1], d[:, 0]) - obs.heading))
+    cs = (jnp.round(bearing / (math.pi / 4)).astype(jnp.int32)) % 8
+    u_rel = jnp.tile(P._abs_sector(obs), L_)
+    a = jnp.arange(8)[:, None]
+    L3 = jnp.concatenate([P._sector_likelihood(a, cs[None]), P._sector_likelihood(a, u_rel[None])], axis=1)
+    L3 = L3 / L3.sum(0, keepdims=True)
+    in_front = valid & (dist <= 3.0) & (jnp.abs(bearing) <= math.pi / 4) & jnp.isin(mem.handle, obs.visible_handle)
+    return (L1, L2, L3), in_front
+
+
+def test_question_eigs_equal_eq1_on_explicit_answer_models(small_benchmark, small_world):
+    """The agent's structured EIG per question type equals Eq. (1),
+    H[b] - E_a H[b | a], evaluated directly on the explicit likelihood
+    matrices of its answer models, along real rollouts."""
+    from ignjax.agents import policies as P
+    from ignjax.sim import env as E
+
+    es = small_benchmark["set"]
+    specs, keys = _batch(es)
+    agent = get_agent("eig")
+    params = agent.default_params()
+    state = jax.vmap(lambda s: E.reset(small_world, s))(specs)
+    obs = jax.vmap(lambda st: E.observe(small_world, st))(state)
+    pst = jax.vmap(lambda o, k: agent.init(params, o, k))(obs, keys)
+    act = jax.jit(jax.vmap(lambda o, a, p, k: agent.act(params, o, a, p, k, None)))
+    step = jax.jit(jax.vmap(lambda st, a: E.step(small_world, st, a)))
+    observe = jax.jit(jax.vmap(lambda st: E.observe(small_world, st)))
+
+    def check(o, ans, mem):
+        mem, b = P._prepare(params, o, ans, mem)
+        got, slot = P.question_eigs(mem, o, ans, b)
+        (L1, L2, L3), in_front = _reference_likelihoods(mem, o)
+        M_ = mem.handle.shape[0]
+        yes = jnp.concatenate([(jnp.arange(M_) == slot).astype(jnp.float32), jnp.zeros(b.shape[0] - M_)])
+        L4 = jnp.stack([yes, 1.0 - yes])
+        ref = jnp.stack([P.expected_information_gain(b, L) for L in (L1, L2, L3, L4)])
+        ref = ref * jnp.stack([~ans.known[0], ~ans.known[1], jnp.array(True), jnp.any(in_front)])
+        return got, jnp.maximum(ref, 0.0), slot, jnp.where(jnp.any(in_front), jnp.argmax(jnp.where(in_front, b[:M_], -1.0)), -1)
+
+    check = jax.jit(jax.vmap(check))
+    n_positive = 0
+    for _ in range(8):
+        got, ref, slot, ref_slot = (np.asarray(x) for x in check(obs, state.answers, pst))
+        np.testing.assert_allclose(got, ref, atol=2e-5)
+        np.testing.assert_array_equal(slot, ref_slot)
+        n_positive += int((ref > 1e-3).sum())
+        a, pst = act(obs, state.answers, pst, keys)
+        state = step(state, a)
+        obs = observe(state)
+    assert n_positive > 50  # the comparison saw informative questions

@@ -108,28 +108,51 @@ def test_collision_rays_stop_motion_within_collision_distance(small_benchmark, s
             assert turn >= math.pi / 4 - 1e-3 or along < 0.6
 
 
-def test_forward_rays_agree_with_mujoco_at_collision_heights(small_benchmark, small_world):
+def test_packed_observation_map_equals_probe_map(small_world):
+    """The observation's packed probe map answers exactly as the fine probe map,
+    inside the grid, on its edges and outside it."""
+    w = small_world
+    g = w.bank.grid
+    n_col = len(w.config.collision_heights)
+    rng = np.random.default_rng(4)
+    for s in range(len(w.bank.scene_ids)):
+        H, W = (int(v) for v in np.asarray(g.shape[s]))
+        o = np.asarray(g.origin[s])
+        xy = o + rng.uniform(-0.5, 1.0, (20000, 2)) * np.array([W, H]) * g.resolution * 1.2
+        xy = jnp.asarray(xy, jnp.float32)
+        fine = np.asarray(E.fine_at(w, jnp.int32(s), xy))
+        packed = np.asarray(E.packed_at(w, w.packed_obs, 2, jnp.int32(s), xy))
+        assert np.array_equal((fine >> n_col) & 3, packed)
+        assert ((fine >> n_col) & 3).any()  # the check saw occupied cells
+
+
+@pytest.mark.parametrize("rng_m,min_agree", [(None, 0.995), (2.0, 0.98)], ids=["controller-range", "2m"])
+def test_forward_rays_agree_with_mujoco_at_collision_heights(small_benchmark, small_world, rng_m, min_agree):
     """Horizontal collision rays (fixed-step march over the fine probe map) against mj_ray.
 
-    Fine cells test the primitives grown sideways by a third of a fine cell,
-    so the march is slightly conservative: >= 98% of rays agree within one
-    navigation cell, a ray that stops early does so only where a real surface
-    lies within about one voxel diagonal of the stopping sample (a near miss
-    of a thin leg or a grazed wall), and at most 0.5% run past a surface
-    (corner grazes thinner than a fine cell).
+    At the range the local controller casts them (``collision_distance``
+    plus one navigation cell) >= 99.5% of random rays agree with mj_ray
+    within one navigation cell. Fine cells test the primitives grown sideways
+    by a third of a fine cell, so the march is slightly conservative: over
+    longer (2 m) rays, which only the free-space observation casts, >= 98%
+    agree; a ray that stops early does so only where a real surface lies
+    within about one voxel diagonal of the stopping sample (a near miss of a
+    thin leg or a grazed wall), and at most 0.5% run past a surface (corner
+    grazes thinner than a fine cell).
     """
     from ignjax.sim.raycast import mj_rays
 
     es = small_benchmark["set"]
     bank = es.bank
     rays = bank.rays
-    step, rng_m = bank.grid.resolution / E.FINE, 2.0
+    step = bank.grid.resolution / E.FINE
+    rng_m = rng_m or small_world.config.collision_distance + bank.grid.resolution
     rng = np.random.default_rng(1)
     n_h = len(small_world.config.collision_heights)
     f = jax.jit(jax.vmap(lambda w, xy, hd, z: jnp.stack([E.probe_free(w, jnp.int32(0), xy, hd, 1 << j, rng_m, step)
                                                           for j in range(n_h)])[z], in_axes=(None, 0, 0, 0)))
     grid = bank.navgrids[0]
-    n = 1500
+    n = 4000
     pts = grid.navigable_points()[rng.integers(len(grid.navigable_points()), size=n)]
     hd = rng.uniform(-math.pi, math.pi, n)
     zi = rng.integers(0, 3, n)
@@ -144,9 +167,10 @@ def test_forward_rays_agree_with_mujoco_at_collision_heights(small_benchmark, sm
     late = got > ref + step + 1e-3
     assert late.mean() <= 0.005, late.mean()
     agree = np.abs(got - ref) <= rays.resolution + step + 1e-4
-    assert agree.mean() >= 0.98, agree.mean()
-
+    assert agree.mean() >= min_agree, agree.mean()
     early = np.where(got < ref - rays.resolution - step - 1e-4)[0]
+    if not len(early):
+        return
     stop = P[early] + V[early] * (got[early] + step)[:, None]  # the first occupied sample
     ox, oy = np.asarray(rays.origin[0])
     w, h, _ = np.asarray(rays.dims[0])
@@ -159,7 +183,7 @@ def test_forward_rays_agree_with_mujoco_at_collision_heights(small_benchmark, sm
     near, _ = mj_rays(bank.compiled[0], np.repeat(inside, len(dirs), 0), np.tile(dirs, (len(inside), 1)), geomgroup=groups)
     near = np.where(np.isfinite(near), near, np.inf).reshape(len(inside), -1).min(1)
     diag = math.sqrt(3) * rays.resolution  # one voxel diagonal, probed along 26 directions (x 1.7 at worst)
-    assert len(inside) > 0 and np.mean(near <= 1.7 * diag) >= 0.99, np.quantile(near, [0.5, 0.99])
+    assert np.mean(near <= 1.7 * diag) >= 0.99, np.quantile(near, [0.5, 0.99])
 
 
 def test_depth_rays_agree_with_mujoco(small_benchmark, small_world):

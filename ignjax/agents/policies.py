@@ -238,35 +238,41 @@ def expected_information_gain(b, L):
 
 
 def question_eigs(mem: Memory, obs: T.Observation, answers: T.Answer, b):
-    """(4,) EIG of each question type on belief ``b``; also the Type-4 slot."""
+    """(4,) EIG of each question type on belief ``b``; also the Type-4 slot.
+
+    Eq. (1) through the mutual-information identity
+    H[b] - E_a H[b | a] = H[p(a)] - sum_h b_h H[p(a | h)], on the structure
+    of each type's answer model: only the (A,) answer distribution p(a) and
+    the answer entropy of each hypothesis are needed."""
     M = mem.handle.shape[0]
-    U = N_ROOM_LABELS * 8
     valid = (mem.handle >= 0) & ~mem.rejected
-    u_label = jnp.repeat(jnp.arange(N_ROOM_LABELS), 8)  # label of each unseen hypothesis
-    u_rel = jnp.tile(_abs_sector(obs), N_ROOM_LABELS)  # relative sector of each unseen hypothesis
-    # Type 1: colour
+    bc, bu = b[:M], b[M:].reshape(N_ROOM_LABELS, 8)  # Shape: (M,), (L, 8)
+    # Type 1: colour; candidates of unobserved colour and unseen hypotheses answer uniformly
     col = mem.attrs[:, 0]
-    L1c = jnp.where(col[None] >= 0, (jnp.arange(N_COLORS)[:, None] == col[None]).astype(jnp.float32), 1.0 / N_COLORS)
-    L1 = jnp.concatenate([L1c, jnp.full((N_COLORS, U), 1.0 / N_COLORS)], axis=1)
-    # Type 2: room label
-    L2c = jnp.where(mem.room[None] >= 0, (jnp.arange(N_ROOM_LABELS)[:, None] == mem.room[None]).astype(jnp.float32),
-                    1.0 / N_ROOM_LABELS)
-    L2u = (jnp.arange(N_ROOM_LABELS)[:, None] == u_label[None]).astype(jnp.float32)
-    L2 = jnp.concatenate([L2c, L2u], axis=1)
-    # Type 3: sector
+    uniform1 = jnp.sum(jnp.where(col < 0, bc, 0.0)) + jnp.sum(bu)
+    pa1 = jnp.sum(jnp.where(jnp.arange(N_COLORS)[:, None] == col[None], bc[None], 0.0), axis=1) + uniform1 / N_COLORS
+    e1 = _entropy(pa1) - uniform1 * math.log(N_COLORS)
+    # Type 2: room label; an unseen hypothesis answers its own label
+    uniform2 = jnp.sum(jnp.where(mem.room < 0, bc, 0.0))
+    pa2 = jnp.sum(jnp.where(jnp.arange(N_ROOM_LABELS)[:, None] == mem.room[None], bc[None], 0.0), axis=1) \
+        + jnp.sum(bu, axis=1) + uniform2 / N_ROOM_LABELS
+    e2 = _entropy(pa2) - uniform2 * math.log(N_ROOM_LABELS)
+    # Type 3: sector; every hypothesis answers a rotation of the same distribution
     dist, bearing = candidate_relative(mem, obs)
     cs = (jnp.round(bearing / (math.pi / 4)).astype(jnp.int32)) % 8
-    a = jnp.arange(8)[:, None]
-    L3 = jnp.concatenate([_sector_likelihood(a, cs[None]), _sector_likelihood(a, u_rel[None])], axis=1)
-    L3 = L3 / L3.sum(0, keepdims=True)
-    # Type 4: the most probable candidate in front within 3 m
-    in_front = valid & (dist <= 3.0) & (jnp.abs(bearing) <= math.pi / 4) & jnp.isin(mem.handle, obs.visible_handle)
-    score = jnp.where(in_front, b[:M], -1.0)
-    slot = jnp.argmax(score)
+    sectors = jnp.arange(8)[:, None]
+    mass = jnp.sum(jnp.where(sectors == cs[None], bc[None], 0.0), axis=1) \
+        + jnp.sum(jnp.where(sectors == _abs_sector(obs)[None], jnp.sum(bu, axis=0)[None], 0.0), axis=1)  # Shape: (8,)
+    L3 = _sector_likelihood(sectors, jnp.arange(8)[None])
+    L3 = L3 / L3.sum(0, keepdims=True)  # Shape: (A, 8) answer given the hypothesis' sector
+    e3 = _entropy(L3 @ mass) - jnp.sum(mass) * _entropy(L3[:, 0])
+    # Type 4: the most probable candidate in front within 3 m; the answer is certain under every hypothesis
+    in_front = valid & (dist <= 3.0) & (jnp.abs(bearing) <= math.pi / 4) \
+        & jnp.any(mem.handle[:, None] == obs.visible_handle[None, :], axis=1)
+    slot = jnp.argmax(jnp.where(in_front, bc, -1.0))
     has = jnp.any(in_front)
-    yes = jnp.concatenate([(jnp.arange(M) == slot).astype(jnp.float32), jnp.zeros(U)])
-    L4 = jnp.stack([yes, 1.0 - yes])
-    e = jnp.stack([expected_information_gain(b, L) for L in (L1, L2, L3, L4)])
+    e4 = _entropy(jnp.stack([bc[slot], jnp.sum(b) - bc[slot]]))
+    e = jnp.stack([e1, e2, e3, e4])
     e = e * jnp.stack([~answers.known[0], ~answers.known[1], jnp.array(True), has])
     return jnp.maximum(e, 0.0), jnp.where(has, slot, -1)
 

@@ -68,7 +68,7 @@ from ignjax.sim import types as T
 _TWO_PI = 2.0 * math.pi
 
 
-@partial(jax.tree_util.register_dataclass, data_fields=["bank", "fields", "fine"], meta_fields=["config"])
+@partial(jax.tree_util.register_dataclass, data_fields=["bank", "fields", "fine", "packed_obs"], meta_fields=["config"])
 @dataclass(frozen=True)
 class World:
     """Everything a rollout reads that is shared by all episodes.
@@ -87,16 +87,28 @@ class World:
             voxel's column segment), so rays that graze a partly occupied
             voxel are not stopped by it; one gather answers every height of
             a probe sample. Derived from the bank when not given.
+        packed_obs: (S, H, W) uint32 the probe map's observation heights
+            packed per navigation cell (:func:`pack_probe_map`): bits
+            ``2 (4 i + j)`` and ``2 (4 i + j) + 1`` are fine cell (i, j) of the
+            cell at eye height and at :data:`LOW_OBS_HEIGHT`. The
+            observation's long free-space rays read it: the same answers as
+            :attr:`fine` from a table a quarter its size (6x faster under
+            ``vmap`` on CPU, where those rays miss the cache). Derived when
+            not given.
     """
 
     bank: SceneBank
     fields: jax.Array
     config: T.SimConfig = T.SimConfig()
     fine: jax.Array | None = None
+    packed_obs: jax.Array | None = None
 
     def __post_init__(self):
         if self.fine is None:
             object.__setattr__(self, "fine", probe_map(self.bank, self.config))
+        n_col = len(self.config.collision_heights)
+        if self.packed_obs is None:
+            object.__setattr__(self, "packed_obs", pack_probe_map(self.fine, (1 << n_col, 1 << (n_col + 1))))
 
 
 LOW_OBS_HEIGHT = 0.45
@@ -114,6 +126,7 @@ def probe_heights(config: T.SimConfig) -> tuple[float, ...]:
 
 
 FINE = 4  # fine probe cells per navigation cell, along each axis
+_FINE_SHIFT = 2  # log2(FINE): packed-map indices by shifts and masks (row >> 2 == row // 4, also below 0)
 FINE_GROW = 0.35  # fine cells test primitives grown by this many fine cells (no ray slips past a corner)
 
 
@@ -199,17 +212,66 @@ def fine_at(world: World, s, xy):
     return jnp.where(inside, b.astype(jnp.int32), 0)
 
 
+def pack_probe_map(fine, groups: tuple[int, ...]) -> jax.Array:
+    """(S, H, W) uint32 probe bits packed per navigation cell.
+
+    Fine cell (i, j) of a navigation cell (i, j in 0..FINE-1, row and column
+    within the cell) owns bits ``len(groups) * (FINE i + j) + g``; bit g is set
+    when the fine cell has any of the probe bits in ``groups[g]``.
+
+    Args:
+        fine: (S, FINE H, FINE W) uint8 probe map (:attr:`World.fine`).
+        groups: probe-bit masks, at most 32 / FINE^2 of them.
+    """
+    n = len(groups)
+    if n * FINE * FINE > 32:
+        raise ValueError(f"{n} groups of {FINE * FINE} fine cells do not fit in 32 bits")
+    f = np.asarray(fine)
+    S, FH, FW = f.shape
+    blocks = f.reshape(S, FH // FINE, FINE, FW // FINE, FINE)
+    out = np.zeros((S, FH // FINE, FW // FINE), np.uint32)
+    for i in range(FINE):
+        for j in range(FINE):
+            for g, m in enumerate(groups):
+                bit = ((blocks[:, :, i, :, j] & m) != 0).astype(np.uint32)
+                out |= bit << np.uint32(n * (FINE * i + j) + g)
+    return jnp.asarray(out)
+
+
+def packed_at(world: World, table, n_groups: int, s, xy):
+    """(...) uint32 group bits of a packed probe map (:func:`pack_probe_map`)
+    at ``xy`` (..., 2); 0 outside the grid, as :func:`fine_at`."""
+    g = world.bank.grid
+    fr = g.resolution / FINE
+    col = jnp.floor((xy[..., 0] - g.origin[s, 0]) / fr).astype(jnp.int32)
+    row = jnp.floor((xy[..., 1] - g.origin[s, 1]) / fr).astype(jnp.int32)
+    inside = (row >= 0) & (col >= 0) & (row < g.shape[s, 0] * FINE) & (col < g.shape[s, 1] * FINE)
+    w = table[s, jnp.clip(row >> _FINE_SHIFT, 0, table.shape[1] - 1), jnp.clip(col >> _FINE_SHIFT, 0, table.shape[2] - 1)]
+    sub = (((row & (FINE - 1)) << _FINE_SHIFT) | (col & (FINE - 1))).astype(jnp.uint32)
+    bits = (w >> (jnp.uint32(n_groups) * sub)) & jnp.uint32((1 << n_groups) - 1)
+    return jnp.where(inside, bits, jnp.uint32(0))
+
+
+def _march(occupied, xy, heading, max_dist: float, step: float):
+    """Free distance along a horizontal ray: the distance of the last sample
+    before the first one where ``occupied`` ((n, 2) points -> (n,) bool) holds
+    (``max_dist`` when none is within range); fixed steps of ``step``."""
+    n = int(math.ceil(max_dist / step))
+    t = jnp.arange(1, n + 1, dtype=jnp.float32) * step
+    pts = xy[None] + t[:, None] * jnp.stack([jnp.cos(heading), jnp.sin(heading)])[None]
+    hit = occupied(pts)
+    return jnp.where(jnp.any(hit), t[jnp.argmax(hit)] - step, jnp.float32(max_dist))
+
+
 def probe_free(world: World, s, xy, heading, mask: int, max_dist: float, step: float):
     """Free distance along a horizontal ray over the fine probe map: the
     distance of the last sample before the first one whose bits in ``mask``
     are set (``max_dist`` when none is within range). Fixed-step (``step``)
-    march over cells of ``resolution / FINE``: within one navigation cell of
-    ``mj_ray`` on >= 99.5% of random rays (tested)."""
-    n = int(math.ceil(max_dist / step))
-    t = jnp.arange(1, n + 1, dtype=jnp.float32) * step
-    pts = xy[None] + t[:, None] * jnp.stack([jnp.cos(heading), jnp.sin(heading)])[None]
-    hit = (fine_at(world, s, pts) & mask) != 0
-    return jnp.where(jnp.any(hit), t[jnp.argmax(hit)] - step, jnp.float32(max_dist))
+    march over cells of ``resolution / FINE``. At the collision heights and
+    the controller's range (``collision_distance`` plus one cell) within one
+    navigation cell of ``mj_ray`` on >= 99.5% of random rays (tested); the
+    observation reads the same bits from :attr:`World.packed_obs`."""
+    return _march(lambda p: (fine_at(world, s, p) & mask) != 0, xy, heading, max_dist, step)
 
 
 # ---------------------------------------------------------------------------
@@ -373,19 +435,22 @@ def execute_move(world: World, state: T.SimState, direction, col, row):
         t = jnp.arange(1, n_samples + 1, dtype=jnp.float32) * spacing  # Shape: (n,)
         col_mask = (1 << len(cfg.collision_heights)) - 1
 
+        n_nav = min(int(math.ceil(cfg.micro_step / spacing)), n_samples)  # samples a micro-step can reach
+        t_nav = t[:n_nav]
+
         def probe(h, length):
-            # one march over the probe map answers the collision rays at every height; the same samples
-            # check the navigability of every cell along the step (no hopping over a thin gap into
-            # another component)
+            # one march over the probe map answers the collision rays at every height; the samples within
+            # the step's length check the navigability of every cell along it (no hopping over a thin gap
+            # into another component)
             u = jnp.stack([jnp.cos(h), jnp.sin(h)])
-            pts = jnp.concatenate([pose[None, :2] + t[:, None] * u[None], (pose[:2] + length * u)[None],
-                                   (pose[:2] + 0.5 * length * u)[None]])
-            hit = (fine_at(world, s, pts[:n_samples]) & col_mask) != 0
+            pts = pose[None, :2] + t[:, None] * u[None]
+            hit = (fine_at(world, s, pts) & col_mask) != 0
             free = jnp.where(jnp.any(hit), t[jnp.argmax(hit)] - spacing, jnp.float32(cfg.collision_distance + res))
-            nav = navigable_at(world, s, pts)
-            along = nav[:n_samples]
-            full = jnp.all(jnp.where(t <= length, along, True)) & nav[n_samples]
-            half = jnp.all(jnp.where(t <= 0.5 * length, along, True)) & nav[n_samples + 1]
+            nav = navigable_at(world, s, jnp.concatenate([pts[:n_nav], (pose[:2] + length * u)[None],
+                                                          (pose[:2] + 0.5 * length * u)[None]]))
+            along = nav[:n_nav]
+            full = jnp.all(jnp.where(t_nav <= length, along, True)) & nav[n_nav]
+            half = jnp.all(jnp.where(t_nav <= 0.5 * length, along, True)) & nav[n_nav + 1]
             return free >= cfg.collision_distance, full, half
 
         ray_ok, full_ok, half_ok = jax.vmap(probe)(headings, lengths)
@@ -637,11 +702,8 @@ def observe(world: World, state: T.SimState) -> T.Observation:
         rel = (jnp.arange(8, dtype=jnp.float32) * (math.pi / 4))[:, None] + within[None]  # Shape: (8, R)
         heads = pose[2] + rel
 
-        n_col = len(cfg.collision_heights)
-        obs_mask = (1 << n_col) | (1 << (n_col + 1))  # eye height and LOW_OBS_HEIGHT
-
-        def free(h):
-            return probe_free(world, s, pose[:2], h, obs_mask, cfg.obs_range, 2 * res)
+        def free(h):  # eye height and LOW_OBS_HEIGHT
+            return _march(lambda p: packed_at(world, world.packed_obs, 2, s, p) != 0, pose[:2], h, cfg.obs_range, 2 * res)
 
         free_space = jax.vmap(jax.vmap(free))(heads)
         # visible instances: K nearest non-structural instances, kept when in sight
