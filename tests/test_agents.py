@@ -138,6 +138,7 @@ def _reference_likelihoods(mem, obs):
     import math
 
     from ignjax.agents import policies as P
+    from ignjax.agents.base import candidate_relative
 
     L_, C_ = P.N_ROOM_LABELS, P.N_COLORS
     U = L_ * 8
@@ -148,9 +149,7 @@ def _reference_likelihoods(mem, obs):
     L2 = jnp.concatenate([jnp.where(mem.room[None] >= 0, (jnp.arange(L_)[:, None] == mem.room[None]).astype(jnp.float32),
                                     1.0 / L_),
                           (jnp.arange(L_)[:, None] == jnp.repeat(jnp.arange(L_), 8)[None]).astype(jnp.float32)], axis=1)
-    d = mem.pos - obs.odometry[None, :2]
-    dist = jnp.linalg.norm(d, axis=1)
-    bearing = jnp.arctan2(jnp.sin(jnp.arctan2(d[:, 1], d[:, 0]) - obs.heading), jnp.cos(jnp.arctan2(d[:, 1], d[:, 0]) - obs.heading))
+    dist, bearing = candidate_relative(mem, obs)
     cs = (jnp.round(bearing / (math.pi / 4)).astype(jnp.int32)) % 8
     u_rel = jnp.tile(P._abs_sector(obs), L_)
     a = jnp.arange(8)[:, None]
