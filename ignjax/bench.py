@@ -40,16 +40,22 @@ def _log(msg: str) -> None:
     print(msg, file=sys.stderr, flush=True)
 
 
+def _bench_house():
+    """The 10-room procedural house every ray figure is measured in."""
+    from ignjax.scenes.procgen import HouseParams, generate_house
+
+    return generate_house(3, HouseParams(n_rooms=10), "bench_house")
+
+
 def bench_rays(quick: bool) -> dict:
     import jax
     import jax.numpy as jnp
 
     from ignjax.scenes.bank import build_navgrid, compile_scene
-    from ignjax.scenes.procgen import HouseParams, generate_house
     from ignjax.sim import rays as SR
     from ignjax.sim.raycast import agreement, benchmark_rays, mj_multiray, random_rays, ray_grid, ray_groups_mask
 
-    house = generate_house(3, HouseParams(n_rooms=10), "bench_house")
+    house = _bench_house()
     t0 = time.perf_counter()
     compiled = compile_scene(house)
     grid = build_navgrid(compiled)
@@ -90,12 +96,11 @@ def bench_probe_rays(quick: bool) -> dict:
     import jax.numpy as jnp
 
     from ignjax.scenes.bank import SceneBank
-    from ignjax.scenes.procgen import HouseParams, generate_house
     from ignjax.sim import env as E
     from ignjax.sim.raycast import mj_rays
     from ignjax.sim.types import SimConfig
 
-    bank = SceneBank.build([generate_house(3, HouseParams(n_rooms=10), "bench_house")])
+    bank = SceneBank.build([_bench_house()])
     cfg = SimConfig()
     world = E.World(bank, jnp.zeros((1,) + tuple(bank.grid.navigable.shape[1:]), jnp.float32), cfg)
     res = bank.grid.resolution

@@ -231,7 +231,9 @@ def _entropy(p, axis=-1):
 
 
 def expected_information_gain(b, L):
-    """Eq. (1): H[b] - E_{a ~ p(a)} H[b | a] for a likelihood matrix L (A, Hyp)."""
+    """Eq. (1): H[b] - E_{a ~ p(a)} H[b | a] for a likelihood matrix L (A, Hyp),
+    the general form (:func:`question_eigs` computes the same quantity from
+    the structure of each answer model; tests check one against the other)."""
     pa = L @ b  # Shape: (A,)
     post = L * b[None] / jnp.where(pa > 0, pa, 1.0)[:, None]
     return _entropy(b) - jnp.sum(pa * _entropy(post, axis=1))

@@ -126,7 +126,8 @@ def probe_heights(config: T.SimConfig) -> tuple[float, ...]:
 
 
 FINE = 4  # fine probe cells per navigation cell, along each axis
-_FINE_SHIFT = 2  # log2(FINE): packed-map indices by shifts and masks (row >> 2 == row // 4, also below 0)
+_FINE_SHIFT = FINE.bit_length() - 1  # log2(FINE): packed-map indices by shifts and masks (also below 0)
+assert 1 << _FINE_SHIFT == FINE, "FINE must be a power of two"
 FINE_GROW = 0.35  # fine cells test primitives grown by this many fine cells (no ray slips past a corner)
 
 
@@ -200,14 +201,20 @@ def probe_map(bank: SceneBank, config: T.SimConfig) -> jax.Array:
     return jnp.asarray(out)
 
 
-def fine_at(world: World, s, xy):
-    """() int32 fine probe bits at ``xy`` (``xy`` (..., 2)); outside the grid (open space beyond an
-    outside door, as ``mj_ray`` sees it) nothing is occupied: the navigable mask keeps the agent in."""
+def _fine_index(world: World, s, xy):
+    """(row, col, inside): the fine probe cell of ``xy`` (..., 2) and whether it lies in the grid."""
     g = world.bank.grid
     fr = g.resolution / FINE
     col = jnp.floor((xy[..., 0] - g.origin[s, 0]) / fr).astype(jnp.int32)
     row = jnp.floor((xy[..., 1] - g.origin[s, 1]) / fr).astype(jnp.int32)
     inside = (row >= 0) & (col >= 0) & (row < g.shape[s, 0] * FINE) & (col < g.shape[s, 1] * FINE)
+    return row, col, inside
+
+
+def fine_at(world: World, s, xy):
+    """() int32 fine probe bits at ``xy`` (``xy`` (..., 2)); outside the grid (open space beyond an
+    outside door, as ``mj_ray`` sees it) nothing is occupied: the navigable mask keeps the agent in."""
+    row, col, inside = _fine_index(world, s, xy)
     b = world.fine[s, jnp.clip(row, 0, world.fine.shape[1] - 1), jnp.clip(col, 0, world.fine.shape[2] - 1)]
     return jnp.where(inside, b.astype(jnp.int32), 0)
 
@@ -241,11 +248,7 @@ def pack_probe_map(fine, groups: tuple[int, ...]) -> jax.Array:
 def packed_at(world: World, table, n_groups: int, s, xy):
     """(...) uint32 group bits of a packed probe map (:func:`pack_probe_map`)
     at ``xy`` (..., 2); 0 outside the grid, as :func:`fine_at`."""
-    g = world.bank.grid
-    fr = g.resolution / FINE
-    col = jnp.floor((xy[..., 0] - g.origin[s, 0]) / fr).astype(jnp.int32)
-    row = jnp.floor((xy[..., 1] - g.origin[s, 1]) / fr).astype(jnp.int32)
-    inside = (row >= 0) & (col >= 0) & (row < g.shape[s, 0] * FINE) & (col < g.shape[s, 1] * FINE)
+    row, col, inside = _fine_index(world, s, xy)
     w = table[s, jnp.clip(row >> _FINE_SHIFT, 0, table.shape[1] - 1), jnp.clip(col >> _FINE_SHIFT, 0, table.shape[2] - 1)]
     sub = (((row & (FINE - 1)) << _FINE_SHIFT) | (col & (FINE - 1))).astype(jnp.uint32)
     bits = (w >> (jnp.uint32(n_groups) * sub)) & jnp.uint32((1 << n_groups) - 1)
