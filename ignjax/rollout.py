@@ -2,9 +2,12 @@
 
 :func:`rollout_episode` runs ONE episode (reset, then ``max_steps`` rounds
 of observe -> act -> step; finished episodes stay finished);
-:func:`rollout` vmaps it over a batch of episodes and jits the whole thing
-once per (agent, batch shape). :func:`rollout_sweep` adds a second vmap over
-agent parameters (e.g. K cost vectors x E episodes in one call).
+:func:`rollout_rows` runs a batch of them with the same results row for row,
+paying only for the work each step's episodes need (the executor for the
+rows that MOVE, the oracle for the rows that ASK, nothing for finished
+rows); :func:`rollout` jits it once per (agent, batch shape), and
+:func:`rollout_sweep` runs K agent parameter settings x E episodes as one
+batch of K E rows (e.g. K cost vectors in one call).
 
 Agents are pure functions (:class:`ignjax.agents.base.Agent`): ``init`` and
 ``act`` see the :class:`~ignjax.sim.types.Observation` and the oracle's
@@ -118,34 +121,89 @@ def _keys(key: jax.Array, n: int) -> jax.Array:
     return key if key.shape == (n,) else jax.random.split(key, n)
 
 
-@partial(jax.jit, static_argnames=("agent",))
-def rollout(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.Array):
+def rollout_rows(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.Array, chunk: int | None = None):
+    """Run a batch of episodes (leading axis B) with per-row agent parameters.
+
+    Row for row the same as :func:`rollout_episode` (tested), organised so
+    the batch pays for the work its episodes need: the agent acts for the
+    unfinished rows only, the executor runs for the rows that MOVE, the
+    oracle for the rows that ASK, and the perception is recomputed for the
+    rows that moved (:func:`ignjax.sim.env.step_batch`,
+    :func:`ignjax.sim.env.observe_batch`, :func:`ignjax.sim.compact.masked_map`).
+
+    Args:
+        params: agent parameters with leading axis B (one setting per row).
+        keys: (B,) per-episode keys.
+        chunk: rows per vectorised call (default: an eighth of the batch).
+
+    Returns:
+        (OutcomeRow, Trajectory, final SimState) with leading axis B.
+    """
+    from ignjax.sim.compact import masked_map
+
+    cfg = world.config
+    state = jax.vmap(lambda sp: E.reset(world, sp))(specs)
+    obs = jax.vmap(lambda st: E.observe(world, st))(state)
+    split = jax.vmap(jax.random.split)(keys)
+    pstate = jax.vmap(agent.init)(params, obs, split[:, 1])
+    step_keys = jnp.swapaxes(jax.vmap(lambda k: jax.random.split(k, cfg.max_steps))(split[:, 0]), 0, 1)
+    privileged = (lambda st: privileged_info(world, st)) if agent.privileged else None
+    priv0 = jax.vmap(privileged)(state) if privileged else None
+    act = lambda x: agent.act(*x)  # noqa: E731
+    no_action = jax.tree.map(lambda a: jnp.zeros(a.shape, a.dtype),
+                             jax.eval_shape(jax.vmap(act), (params, obs, state.answers, pstate, step_keys[0], priv0))[0])
+
+    def body(carry, k):
+        state, obs, pstate, priv = carry
+        was_done = state.done
+        action, pstate = masked_map(act, ~was_done, (params, obs, state.answers, pstate, k, priv), (no_action, pstate), chunk)
+        state = E.step_batch(world, state, action, chunk)
+        kind = jnp.where(was_done, -1, jnp.clip(action.kind, 0, 2))
+        obs = E.observe_batch(world, state, obs, kind == T.MOVE, chunk)
+        priv = masked_map(privileged, ~state.done, state, priv, chunk) if privileged else None
+        q = jnp.where((kind == T.ASK), jnp.clip(action.question, 1, 4), 0)
+        return (state, obs, pstate, priv), (state.pose, kind.astype(jnp.int32), q.astype(jnp.int32))
+
+    (state, _, _, _), (poses, kinds, qs) = jax.lax.scan(body, (state, obs, pstate, priv0), step_keys)
+    traj = Trajectory(pose=jnp.concatenate([specs.start[:, None].astype(jnp.float32), jnp.swapaxes(poses, 0, 1)], 1),
+                      kind=kinds.T, question=qs.T)
+    return jax.vmap(lambda st: E.outcome(world, st))(state), traj, state
+
+
+@partial(jax.jit, static_argnames=("agent", "chunk"))
+def rollout(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.Array, chunk: int | None = None):
     """Run a batch of episodes (leading axis E of ``specs``) with one agent.
 
     Args:
         keys: (E,) per-episode keys (see :func:`episode_keys`), or one key
             that is split.
+        chunk: rows per vectorised call (:func:`rollout_rows`).
 
     Returns:
         (OutcomeRow, Trajectory) with leading axis E.
     """
-    keys = _keys(keys, specs.scene.shape[0])
-    out, traj, _ = jax.vmap(lambda s, k: rollout_episode(world, s, agent, params, k))(specs, keys)
-    return out, traj
+    n = specs.scene.shape[0]
+    keys = _keys(keys, n)
+    rows = jax.tree.map(lambda x: jnp.broadcast_to(x, (n,) + jnp.shape(x)), params)
+    return rollout_rows(world, specs, agent, rows, keys, chunk)[:2]
 
 
-@partial(jax.jit, static_argnames=("agent",))
-def rollout_sweep(world: E.World, specs: T.EpisodeSpec, agent, params_batch, keys: jax.Array):
+@partial(jax.jit, static_argnames=("agent", "chunk"))
+def rollout_sweep(world: E.World, specs: T.EpisodeSpec, agent, params_batch, keys: jax.Array, chunk: int | None = None):
     """Run every episode under every parameter setting (leading axis K of
-    ``params_batch``): K x E episodes in one call, the same key per episode
-    across settings (paired comparisons).
+    ``params_batch``): K x E episodes in one call, as one batch of K E rows,
+    the same key per episode across settings (paired comparisons).
 
     Returns:
         (OutcomeRow, Trajectory) with leading axes (K, E).
     """
-    keys = _keys(keys, specs.scene.shape[0])
-    per_params = lambda p: jax.vmap(lambda s, k: rollout_episode(world, s, agent, p, k))(specs, keys)[:2]  # noqa: E731
-    return jax.vmap(per_params)(params_batch)
+    n = specs.scene.shape[0]
+    keys = _keys(keys, n)
+    K = jax.tree.leaves(params_batch)[0].shape[0]
+    rows = jax.tree.map(lambda x: jnp.repeat(x, n, axis=0), params_batch)
+    tile = jnp.tile(jnp.arange(n), K)
+    out = rollout_rows(world, jax.tree.map(lambda a: a[tile], specs), agent, rows, keys[tile], chunk)[:2]
+    return jax.tree.map(lambda a: a.reshape((K, n) + a.shape[1:]), out)
 
 
 def pad_specs(specs: T.EpisodeSpec, size: int) -> T.EpisodeSpec:

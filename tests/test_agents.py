@@ -199,3 +199,30 @@ def test_question_eigs_equal_eq1_on_explicit_answer_models(small_benchmark, smal
         state = step(state, a)
         obs = observe(state)
     assert n_positive > 50  # the comparison saw informative questions
+
+
+def _assert_rows_match(got, want):
+    """Discrete fields exactly, continuous ones to float32 rounding."""
+    for a, b in zip(jax.tree.leaves(got), jax.tree.leaves(want)):
+        a, b = np.asarray(a), np.asarray(b)
+        if a.dtype.kind == "f":
+            np.testing.assert_allclose(a, b, atol=1e-4, rtol=1e-5)
+        else:
+            np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("name", ["shortest_path", "naive_asker", "eig"])
+def test_batched_rollout_equals_one_episode_rollout(small_benchmark, small_world, runs, name):
+    """The batch rollout (executor for the movers only, oracle for the askers
+    only, nothing for finished rows; rollout_sweep's K x E rows) gives row for
+    row what the one-episode reference ``rollout_episode`` gives under vmap."""
+    es = small_benchmark["set"]
+    specs, keys = _batch(es)
+    agent = get_agent(name)
+    if name == "eig":
+        k = SCALES.index(1.0)
+        params, got = jax.tree.map(lambda a: a[k], runs["eig_params"]), _sweep_row(runs, k)
+    else:
+        params, got = agent.default_params(), runs[name]
+    ref = jax.jit(jax.vmap(lambda s, key: rollout_episode(small_world, s, agent, params, key)[:2]))(specs, keys)
+    _assert_rows_match(got, ref)

@@ -414,67 +414,121 @@ def forward_free(world: World, s, xy, heading):
     return probe_free(world, s, xy, heading, mask, cfg.collision_distance + res, res / FINE)
 
 
-def execute_move(world: World, state: T.SimState, direction, col, row):
-    """Run the executor for one MOVE. Returns the updated pose, path length,
-    minimum geodesic distance, blocked mask, waypoint and distance moved."""
+def _probe(world: World, s, xy, h, length):
+    """One candidate heading of a micro-step: (rays clear, full step navigable, half step navigable).
+
+    One march over the probe map answers the collision rays at every height;
+    the samples within the step's length check the navigability of every cell
+    along it (no hopping over a thin gap into another component)."""
     cfg = world.config
-    ep = state.episode
+    res = world.bank.grid.resolution
+    spacing = res / FINE  # one sample per fine cell: nothing thicker than a fine cell is skipped
+    n_samples = int(math.ceil((cfg.collision_distance + res) / spacing))
+    t = jnp.arange(1, n_samples + 1, dtype=jnp.float32) * spacing  # Shape: (n,)
+    col_mask = (1 << len(cfg.collision_heights)) - 1
+    n_nav = min(int(math.ceil(cfg.micro_step / spacing)), n_samples)  # samples a micro-step can reach
+    t_nav = t[:n_nav]
+    u = jnp.stack([jnp.cos(h), jnp.sin(h)])
+    pts = xy[None] + t[:, None] * u[None]
+    hit = (fine_at(world, s, pts) & col_mask) != 0
+    free = jnp.where(jnp.any(hit), t[jnp.argmax(hit)] - spacing, jnp.float32(cfg.collision_distance + res))
+    nav = navigable_at(world, s, jnp.concatenate([pts[:n_nav], (xy + length * u)[None], (xy + 0.5 * length * u)[None]]))
+    along = nav[:n_nav]
+    full = jnp.all(jnp.where(t_nav <= length, along, True)) & nav[n_nav]
+    half = jnp.all(jnp.where(t_nav <= 0.5 * length, along, True)) & nav[n_nav + 1]
+    return (free >= cfg.collision_distance) & (full | half), full
+
+
+_OFFSETS = (0.0, 1.0, -1.0, 2.0, -2.0, 3.0, -3.0, 4.0)  # candidate headings, x 45 degrees: desired first, left first
+
+
+def execute_moves(world: World, states: T.SimState, direction, col, row, mask, chunk: int | None = None):
+    """Run the executor for the MOVEs of a batch (leading axis B).
+
+    The same controller as one episode's :func:`execute_move`, organised so
+    a batch pays only for the work its episodes need (:func:`ignjax.sim.compact.masked_map`):
+    waypoints are cast for the rows in ``mask`` only, micro-steps run while
+    any row is still moving, each micro-step probes the desired heading of
+    the moving rows and the seven neighbouring headings only of the rows
+    whose desired heading is blocked. Row for row the results equal the
+    one-episode definition (the first free heading in :data:`_OFFSETS` order).
+
+    Args:
+        states: (B,) SimState.
+        direction, col, row: (B,) int32 the MOVE's view and grid cell.
+        mask: (B,) bool rows that execute a MOVE; the other rows' outputs
+            are their current pose, no motion, their minimum distance, no
+            blocked heading and their pose as the waypoint.
+        chunk: rows per vectorised call (:func:`ignjax.sim.compact.chunk_size` by default).
+
+    Returns:
+        (pose (B, 3), moved (B,), min_distance (B,), blocked (B, 8), waypoint (B, 2)).
+    """
+    from ignjax.sim.compact import masked_map
+
+    cfg = world.config
+    ep = states.episode
     s = ep.scene
-    wp, _, _, _ = pixel_waypoint(world, s, state.pose, direction, col, row)
-    yaw0 = state.pose[2]
-    offsets = jnp.array([0.0, 1.0, -1.0, 2.0, -2.0, 3.0, -3.0, 4.0], jnp.float32) * (math.pi / 4)
+    pose0 = states.pose
+    B = mask.shape[0]
+    wp = masked_map(lambda a: pixel_waypoint(world, *a)[0], mask, (s, pose0, direction, col, row), pose0[:, :2], chunk)
+    yaw0 = pose0[:, 2]
+    offsets = jnp.array(_OFFSETS, jnp.float32) * (math.pi / 4)
+    rows = jnp.arange(B)
 
-    def micro(_, carry):
-        pose, moved, dmin, blocked, active = carry
-        r, beta = G.relative_target(pose[:2], pose[2], wp)
+    def cond(carry):
+        i, active = carry[0], carry[-1]
+        return (i < cfg.max_micro_steps) & jnp.any(active)
+
+    def micro(carry):
+        i, pose, moved, dmin, blocked, active = carry
+        r, beta = jax.vmap(G.relative_target)(pose[:, :2], pose[:, 2], wp)
         active = active & (r > cfg.waypoint_tolerance)
-        h0 = pose[2] + beta
-        headings = h0 + offsets  # Shape: (8,) desired heading first, then nearest neighbours, left first
-        lengths = jnp.where(jnp.arange(8) == 0, jnp.minimum(cfg.micro_step, r), cfg.micro_step)
-
-        res = world.bank.grid.resolution
-        spacing = res / FINE  # one sample per fine cell: nothing thicker than a fine cell is skipped
-        n_samples = int(math.ceil((cfg.collision_distance + res) / spacing))
-        t = jnp.arange(1, n_samples + 1, dtype=jnp.float32) * spacing  # Shape: (n,)
-        col_mask = (1 << len(cfg.collision_heights)) - 1
-
-        n_nav = min(int(math.ceil(cfg.micro_step / spacing)), n_samples)  # samples a micro-step can reach
-        t_nav = t[:n_nav]
-
-        def probe(h, length):
-            # one march over the probe map answers the collision rays at every height; the samples within
-            # the step's length check the navigability of every cell along it (no hopping over a thin gap
-            # into another component)
-            u = jnp.stack([jnp.cos(h), jnp.sin(h)])
-            pts = pose[None, :2] + t[:, None] * u[None]
-            hit = (fine_at(world, s, pts) & col_mask) != 0
-            free = jnp.where(jnp.any(hit), t[jnp.argmax(hit)] - spacing, jnp.float32(cfg.collision_distance + res))
-            nav = navigable_at(world, s, jnp.concatenate([pts[:n_nav], (pose[:2] + length * u)[None],
-                                                          (pose[:2] + 0.5 * length * u)[None]]))
-            along = nav[:n_nav]
-            full = jnp.all(jnp.where(t_nav <= length, along, True)) & nav[n_nav]
-            half = jnp.all(jnp.where(t_nav <= 0.5 * length, along, True)) & nav[n_nav + 1]
-            return free >= cfg.collision_distance, full, half
-
-        ray_ok, full_ok, half_ok = jax.vmap(probe)(headings, lengths)
-        ok = ray_ok & (full_ok | half_ok)
-        k = jnp.argmax(ok)
-        any_ok = jnp.any(ok)
+        h0 = pose[:, 2] + beta
+        len0 = jnp.minimum(cfg.micro_step, r)
+        ok0, full0 = masked_map(lambda a: _probe(world, *a), active, (s, pose[:, :2], h0, len0),
+                                (jnp.zeros(B, bool), jnp.zeros(B, bool)), chunk)
+        alt = jax.vmap(lambda s_, xy, h: _probe(world, s_, xy, h, jnp.float32(cfg.micro_step)), in_axes=(None, None, 0))
+        ok_alt, full_alt = masked_map(lambda a: alt(a[0], a[1], a[2] + offsets[1:]), active & ~ok0, (s, pose[:, :2], h0),
+                                      (jnp.zeros((B, 7), bool), jnp.zeros((B, 7), bool)), chunk)
+        ok = jnp.concatenate([ok0[:, None], ok_alt], 1)
+        full = jnp.concatenate([full0[:, None], full_alt], 1)
+        k = jnp.argmax(ok, axis=1)
+        any_ok = jnp.any(ok, axis=1)
         sec = _sector(h0 - yaw0)
-        blocked = blocked.at[sec].set(blocked[sec] | (~ok[0] & active))
-        heading = headings[k]
-        length = jnp.where(full_ok[k], lengths[k], 0.5 * lengths[k])
-        new_xy = pose[:2] + length * jnp.stack([jnp.cos(heading), jnp.sin(heading)])
+        blocked = blocked.at[rows, sec].set(blocked[rows, sec] | (~ok0 & active))
+        heading = h0 + offsets[k]
+        lengths = jnp.where(k == 0, len0, jnp.float32(cfg.micro_step))
+        length = jnp.where(full[rows, k], lengths, 0.5 * lengths)
+        new_xy = pose[:, :2] + length[:, None] * jnp.stack([jnp.cos(heading), jnp.sin(heading)], 1)
         can = active & any_ok
-        pose = jnp.where(can, jnp.concatenate([new_xy, heading[None]]), pose)
+        pose = jnp.where(can[:, None], jnp.concatenate([new_xy, heading[:, None]], 1), pose)
         moved = moved + jnp.where(can, length, 0.0)
-        dmin = jnp.where(can, jnp.minimum(dmin, geodesic_to_target(world, ep, new_xy)), dmin)
-        return pose, moved, dmin, blocked, can
+        d_new = jax.vmap(lambda e, xy: geodesic_to_target(world, e, xy))(ep, new_xy)
+        dmin = jnp.where(can, jnp.minimum(dmin, d_new), dmin)
+        return i + 1, pose, moved, dmin, blocked, can
 
-    init = (state.pose, jnp.float32(0.0), state.min_distance, jnp.zeros(8, bool), jnp.array(True))
-    pose, moved, dmin, blocked, _ = jax.lax.fori_loop(0, cfg.max_micro_steps, micro, init)
-    pose = pose.at[2].set(G.wrap_angle(pose[2]))
+    init = (jnp.int32(0), pose0, jnp.zeros(B, jnp.float32), states.min_distance, jnp.zeros((B, 8), bool), mask)
+    _, pose, moved, dmin, blocked, _ = jax.lax.while_loop(cond, micro, init)
+    pose = jnp.where(mask[:, None], pose.at[:, 2].set(G.wrap_angle(pose[:, 2])), pose)
     return pose, moved, dmin, blocked, wp
+
+
+def _one(tree):
+    return jax.tree.map(lambda x: x[None], tree)
+
+
+def _unone(tree):
+    return jax.tree.map(lambda x: x[0], tree)
+
+
+def execute_move(world: World, state: T.SimState, direction, col, row):
+    """Run the executor for one MOVE of one episode (:func:`execute_moves` on a batch of one).
+
+    Returns the updated pose, path length moved, minimum geodesic distance,
+    blocked mask and waypoint."""
+    args = _one((state, direction, col, row, jnp.array(True)))
+    return _unone(execute_moves(world, *args))
 
 
 # ---------------------------------------------------------------------------
@@ -654,35 +708,48 @@ def sanitize_action(action: T.Action) -> tuple[T.Action, jax.Array]:
     return T.Action(kind, d, c, r, q, action.candidate), bad
 
 
-def step(world: World, state: T.SimState, action: T.Action) -> T.SimState:
-    """One planner step of one episode (pure). Finished episodes stay put."""
+def step_batch(world: World, states: T.SimState, actions: T.Action, chunk: int | None = None) -> T.SimState:
+    """One planner step of a batch of episodes (leading axis B); finished episodes stay put.
+
+    Row for row the same as :func:`step`; the executor runs for the rows that
+    MOVE and the oracle for the rows that ASK only (:func:`execute_moves`,
+    :func:`ignjax.sim.compact.masked_map`)."""
+    from ignjax.sim.compact import masked_map
+
     with jax.named_scope("sim_step"):
         cfg = world.config
-        act, bad = sanitize_action(action)
-        ep = state.episode
-        is_move = act.kind == T.MOVE
-        is_ask = act.kind == T.ASK
+        act, bad = jax.vmap(sanitize_action)(actions)
+        live = ~states.done
+        is_move = (act.kind == T.MOVE) & live
+        is_ask = (act.kind == T.ASK) & live
         is_stop = act.kind == T.STOP
 
         # MOVE
-        pose, moved, dmin, blocked, wp = execute_move(world, state, act.direction, act.col, act.row)
-        a = state.answers
-        progress = _hint_progress(world, ep, a, state.pose[:2], pose[:2])
+        pose, moved, dmin, blocked, wp = execute_moves(world, states, act.direction, act.col, act.row, is_move, chunk)
+        a = states.answers
+        progress = jax.vmap(lambda e, ans, p0, p1: _hint_progress(world, e, ans, p0, p1))(
+            states.episode, a, states.pose[:, :2], pose[:, :2])
         moved_state = dataclasses.replace(
-            state, pose=pose, path_length=state.path_length + moved, min_distance=dmin, blocked=blocked,
-            last_move=moved, waypoint=wp, moves_since_confirm=state.moves_since_confirm + 1,
+            states, pose=pose, path_length=states.path_length + moved, min_distance=dmin, blocked=blocked,
+            last_move=moved, waypoint=wp, moves_since_confirm=states.moves_since_confirm + 1,
             answers=dataclasses.replace(a, hint_progress=progress),
         )
         # ASK
-        asked_state = ask(world, state, act.question, act.candidate)
-        nxt = T.tree_select(is_move, moved_state, T.tree_select(is_ask, asked_state, state))
-        n_step = state.step + 1
+        asked_state = masked_map(lambda x: ask(world, *x), is_ask, (states, act.question, act.candidate), states, chunk)
+        sel = lambda m, x, y: jax.tree.map(lambda u, v: jnp.where(m.reshape(m.shape + (1,) * (u.ndim - 1)), u, v), x, y)  # noqa: E731
+        nxt = sel(is_move, moved_state, sel(is_ask, asked_state, states))
+        n_step = states.step + 1
         stop_reason = jnp.where(is_stop, T.STOPPED, jnp.where(n_step >= cfg.max_steps, T.OUT_OF_STEPS, T.RUNNING))
         nxt = dataclasses.replace(
-            nxt, step=n_step, n_invalid=state.n_invalid + bad.astype(jnp.int32),
+            nxt, step=n_step, n_invalid=states.n_invalid + bad.astype(jnp.int32),
             done=stop_reason != T.RUNNING, stop_reason=stop_reason.astype(jnp.int32),
         )
-        return T.tree_select(state.done, state, nxt)
+        return sel(states.done, states, nxt)
+
+
+def step(world: World, state: T.SimState, action: T.Action) -> T.SimState:
+    """One planner step of one episode (pure). Finished episodes stay put."""
+    return _unone(step_batch(world, _one(state), _one(action)))
 
 
 # ---------------------------------------------------------------------------
@@ -729,20 +796,39 @@ def observe(world: World, state: T.SimState) -> T.Observation:
 
         room = room_at(world, s, pose[:2])
         label = jnp.where(room >= 0, bank.rooms.label[s, jnp.maximum(room, 0)], -1)
-        start = ep.start
         return T.Observation(
-            heading=pose[2], odometry=jnp.stack([pose[0] - start[0], pose[1] - start[1], G.wrap_angle(pose[2] - start[2])]),
             free_space=free_space, visible_handle=padk(handle, -1),
             visible_category=padk(jnp.where(seen, inst.category[s, idx], -1).astype(jnp.int32), -1),
             visible_attrs=padk(jnp.where(seen[:, None], attrs, -1).astype(jnp.int32), -1),
             visible_range=padk(jnp.where(seen, dist, jnp.inf), jnp.inf),
             visible_bearing=padk(jnp.where(seen, bearing, 0.0), 0.0),
             visible_view=padk(jnp.where(seen, _sector(bearing), -1), -1),
-            room_label=label.astype(jnp.int32), goal_category=ep.category,
-            steps_left=jnp.int32(cfg.max_steps) - state.step,
-            questions_left=jnp.int32(cfg.max_questions) - jnp.sum(state.n_questions),
-            n_questions=state.n_questions, blocked=state.blocked, last_move=state.last_move,
+            room_label=label.astype(jnp.int32), **_state_fields(world, state),
         )
+
+
+def _state_fields(world: World, state: T.SimState) -> dict:
+    """The observation's fields read from the state alone (heading, odometry, budgets, last MOVE)."""
+    cfg = world.config
+    pose, start = state.pose, state.episode.start
+    return dict(
+        heading=pose[2], odometry=jnp.stack([pose[0] - start[0], pose[1] - start[1], G.wrap_angle(pose[2] - start[2])]),
+        goal_category=state.episode.category, steps_left=jnp.int32(cfg.max_steps) - state.step,
+        questions_left=jnp.int32(cfg.max_questions) - jnp.sum(state.n_questions),
+        n_questions=state.n_questions, blocked=state.blocked, last_move=state.last_move,
+    )
+
+
+def observe_batch(world: World, states: T.SimState, previous: T.Observation, moved, chunk: int | None = None) -> T.Observation:
+    """:func:`observe` of a batch (leading axis B) after a step: the
+    perception (rays, visible instances, room) is recomputed for the rows in
+    ``moved`` only; every other row's pose is unchanged, so it keeps
+    ``previous``'s perception with its state fields refreshed. Row for row
+    the same as ``vmap(observe)``."""
+    from ignjax.sim.compact import masked_map
+
+    obs = masked_map(lambda st: observe(world, st), moved, states, previous, chunk)
+    return dataclasses.replace(obs, **jax.vmap(lambda st: _state_fields(world, st))(states))
 
 
 # ---------------------------------------------------------------------------

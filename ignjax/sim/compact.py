@@ -1,0 +1,58 @@
+"""Masked batch maps that pay only for the rows that need the work.
+
+Under ``vmap`` every episode pays for every branch: a batch where 60% of
+the episodes MOVE, 12% ASK and the rest have finished still runs the
+executor, the oracle and the perception for all of them. :func:`masked_map`
+runs a per-row function on the rows a mask selects only: their indices are
+compacted (``jnp.nonzero`` with a static size) and processed in fixed-size
+chunks inside a loop whose trip count is the number of chunks the mask
+needs, so the cost follows the number of selected rows (rounded up to a
+chunk) while every shape stays static. Rows outside the mask keep their
+``default`` values. The result is the same as ``where(mask, vmap(fn)(args),
+default)`` row for row (tested), whatever the chunk size.
+"""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+
+CHUNKS = 8  # default chunk: 1/CHUNKS of the batch (at most that fraction of a batch is padding)
+
+
+def chunk_size(n_rows: int, chunks: int = CHUNKS) -> int:
+    """Rows per chunk for a batch of ``n_rows``: ``ceil(n_rows / chunks)``, at least 1."""
+    return max(1, -(-int(n_rows) // int(chunks)))
+
+
+def masked_map(fn, mask, args, default, chunk: int | None = None):
+    """``where(mask, vmap(fn)(args), default)``, computing ``fn`` on the selected rows only.
+
+    Args:
+        fn: one row's ``args`` -> a pytree shaped like one row of ``default``.
+        mask: (B,) bool rows to compute.
+        args: pytree of arrays with leading axis B.
+        default: pytree with leading axis B: the result on unselected rows
+            (and its dtypes are the result's).
+        chunk: rows per vectorised call (static); default :func:`chunk_size`.
+
+    Returns:
+        A pytree like ``default``.
+    """
+    B = mask.shape[0]
+    c = chunk_size(B) if chunk is None else max(1, min(int(chunk), B))
+    n_chunks = -(-B // c)
+    idx = jnp.nonzero(mask, size=n_chunks * c, fill_value=B)[0].astype(jnp.int32)
+    n_sel = jnp.sum(mask.astype(jnp.int32))
+    trips = (n_sel + c - 1) // c
+    row_fn = jax.vmap(fn)
+
+    def body(i, out):
+        rows = jax.lax.dynamic_slice(idx, (i * c,), (c,))
+        take = jnp.minimum(rows, B - 1)
+        vals = row_fn(jax.tree.map(lambda a: a[take], args))
+        return jax.tree.map(
+            lambda o, v: o.at[rows].set(v.astype(o.dtype), mode="drop", indices_are_sorted=True),
+            out, vals)
+
+    return jax.lax.fori_loop(0, trips, body, default)
