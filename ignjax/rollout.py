@@ -110,6 +110,15 @@ def rollout_episode(world: E.World, spec: T.EpisodeSpec, agent, params, key: jax
     return E.outcome(world, state), traj, state
 
 
+# Compiler options of the rollout jits. XLA:CPU compiles loop bodies (the scan
+# over planner steps and the masked batch maps inside it) several times slower
+# with its MLIR fusion emitters than with the classic ones: the simulator's
+# gather-heavy ray marches ran 3-4x slower inside a while loop than the same
+# code at top level (jax/jaxlib 0.10.2, 2-core CPU), and whole rollouts about
+# 1.7x slower. The option is a CPU one; other backends ignore it.
+ROLLOUT_COMPILER_OPTIONS = {"xla_cpu_use_fusion_emitters": False}
+
+
 def episode_keys(seed: int, indices) -> jax.Array:
     """One PRNG key per episode, from the seed and the episode's index in its
     file, so results do not depend on how episodes are batched."""
@@ -170,7 +179,7 @@ def rollout_rows(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.
     return jax.vmap(lambda st: E.outcome(world, st))(state), traj, state
 
 
-@partial(jax.jit, static_argnames=("agent", "chunk"))
+@partial(jax.jit, static_argnames=("agent", "chunk"), compiler_options=ROLLOUT_COMPILER_OPTIONS)
 def rollout(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.Array, chunk: int | None = None):
     """Run a batch of episodes (leading axis E of ``specs``) with one agent.
 
@@ -188,7 +197,7 @@ def rollout(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.Array
     return rollout_rows(world, specs, agent, rows, keys, chunk)[:2]
 
 
-@partial(jax.jit, static_argnames=("agent", "chunk"))
+@partial(jax.jit, static_argnames=("agent", "chunk"), compiler_options=ROLLOUT_COMPILER_OPTIONS)
 def rollout_sweep(world: E.World, specs: T.EpisodeSpec, agent, params_batch, keys: jax.Array, chunk: int | None = None):
     """Run every episode under every parameter setting (leading axis K of
     ``params_batch``): K x E episodes in one call, as one batch of K E rows,

@@ -1,7 +1,11 @@
 """The simulator: pure ``reset`` / ``step`` / ``observe`` / ``outcome`` for ONE episode.
 
-Batching is ``jax.vmap`` applied once, by the caller (:mod:`ignjax.rollout`);
-the :class:`World` (scene bank + goal fields) is passed unbatched.
+Batching is ``jax.vmap`` applied once, by the caller; the :class:`World`
+(scene bank + goal fields) is passed unbatched. :func:`step_batch`,
+:func:`execute_moves` and :func:`observe_batch` are the same transitions for
+a batch, organised so that rows pay only for the work they need (used by
+:func:`ignjax.rollout.rollout_rows`); the one-episode :func:`step` is
+:func:`step_batch` on a batch of one, so there is one executor.
 
 Protocol (paper §3.3, Appendix C; constants in :class:`~ignjax.sim.types.SimConfig`):
 
