@@ -29,6 +29,7 @@ import jax.numpy as jnp
 
 from ignjax.sim import env as E
 from ignjax.sim import types as T
+from ignjax.sim.compact import masked_map
 
 
 @partial(jax.tree_util.register_dataclass, data_fields=["geodesic", "best_direction", "best_col", "best_row", "best_value"],
@@ -148,8 +149,6 @@ def rollout_rows(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.
     Returns:
         (OutcomeRow, Trajectory, final SimState) with leading axis B.
     """
-    from ignjax.sim.compact import masked_map
-
     cfg = world.config
     state = jax.vmap(lambda sp: E.reset(world, sp))(specs)
     obs = jax.vmap(lambda st: E.observe(world, st))(state)

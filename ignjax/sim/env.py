@@ -68,6 +68,7 @@ from ignjax.scenes.bank import SceneBank
 from ignjax.sim import geometry as G
 from ignjax.sim import rays as SR
 from ignjax.sim import types as T
+from ignjax.sim.compact import masked_map
 
 _TWO_PI = 2.0 * math.pi
 
@@ -419,7 +420,9 @@ def forward_free(world: World, s, xy, heading):
 
 
 def _probe(world: World, s, xy, h, length):
-    """One candidate heading of a micro-step: (rays clear, full step navigable, half step navigable).
+    """One candidate heading of a micro-step: (free, full) - whether the heading
+    is free (collision rays clear and its full or half step navigable) and
+    whether its full step is navigable.
 
     One march over the probe map answers the collision rays at every height;
     the samples within the step's length check the navigability of every cell
@@ -449,13 +452,14 @@ _OFFSETS = (0.0, 1.0, -1.0, 2.0, -2.0, 3.0, -3.0, 4.0)  # candidate headings, x 
 def execute_moves(world: World, states: T.SimState, direction, col, row, mask, chunk: int | None = None):
     """Run the executor for the MOVEs of a batch (leading axis B).
 
-    The same controller as one episode's :func:`execute_move`, organised so
-    a batch pays only for the work its episodes need (:func:`ignjax.sim.compact.masked_map`):
+    The controller of the module docstring (one episode's :func:`execute_move`
+    is this function on a batch of one), organised so a batch pays only for
+    the work its episodes need (:func:`ignjax.sim.compact.masked_map`):
     waypoints are cast for the rows in ``mask`` only, micro-steps run while
     any row is still moving, each micro-step probes the desired heading of
     the moving rows and the seven neighbouring headings only of the rows
-    whose desired heading is blocked. Row for row the results equal the
-    one-episode definition (the first free heading in :data:`_OFFSETS` order).
+    whose desired heading is blocked; each row takes the first free heading in
+    :data:`_OFFSETS` order, so a row's result does not depend on the others.
 
     Args:
         states: (B,) SimState.
@@ -468,8 +472,6 @@ def execute_moves(world: World, states: T.SimState, direction, col, row, mask, c
     Returns:
         (pose (B, 3), moved (B,), min_distance (B,), blocked (B, 8), waypoint (B, 2)).
     """
-    from ignjax.sim.compact import masked_map
-
     cfg = world.config
     ep = states.episode
     s = ep.scene
@@ -718,8 +720,6 @@ def step_batch(world: World, states: T.SimState, actions: T.Action, chunk: int |
     Row for row the same as :func:`step`; the executor runs for the rows that
     MOVE and the oracle for the rows that ASK only (:func:`execute_moves`,
     :func:`ignjax.sim.compact.masked_map`)."""
-    from ignjax.sim.compact import masked_map
-
     with jax.named_scope("sim_step"):
         cfg = world.config
         act, bad = jax.vmap(sanitize_action)(actions)
@@ -740,15 +740,14 @@ def step_batch(world: World, states: T.SimState, actions: T.Action, chunk: int |
         )
         # ASK
         asked_state = masked_map(lambda x: ask(world, *x), is_ask, (states, act.question, act.candidate), states, chunk)
-        sel = lambda m, x, y: jax.tree.map(lambda u, v: jnp.where(m.reshape(m.shape + (1,) * (u.ndim - 1)), u, v), x, y)  # noqa: E731
-        nxt = sel(is_move, moved_state, sel(is_ask, asked_state, states))
+        nxt = T.tree_select(is_move, moved_state, T.tree_select(is_ask, asked_state, states))
         n_step = states.step + 1
         stop_reason = jnp.where(is_stop, T.STOPPED, jnp.where(n_step >= cfg.max_steps, T.OUT_OF_STEPS, T.RUNNING))
         nxt = dataclasses.replace(
             nxt, step=n_step, n_invalid=states.n_invalid + bad.astype(jnp.int32),
             done=stop_reason != T.RUNNING, stop_reason=stop_reason.astype(jnp.int32),
         )
-        return sel(states.done, states, nxt)
+        return T.tree_select(states.done, states, nxt)
 
 
 def step(world: World, state: T.SimState, action: T.Action) -> T.SimState:
@@ -829,8 +828,6 @@ def observe_batch(world: World, states: T.SimState, previous: T.Observation, mov
     ``moved`` only; every other row's pose is unchanged, so it keeps
     ``previous``'s perception with its state fields refreshed. Row for row
     the same as ``vmap(observe)``."""
-    from ignjax.sim.compact import masked_map
-
     obs = masked_map(lambda st: observe(world, st), moved, states, previous, chunk)
     return dataclasses.replace(obs, **jax.vmap(lambda st: _state_fields(world, st))(states))
 

@@ -334,8 +334,12 @@ class SimState:
 
 
 def tree_select(pred, on_true, on_false):
-    """Elementwise ``where`` over two pytrees of the same structure."""
-    return jax.tree.map(lambda a, b: jnp.where(pred, a, b), on_true, on_false)
+    """Elementwise ``where`` over two pytrees of the same structure; ``pred``
+    selects along the leading axes (a () pred a whole tree, a (B,) pred rows
+    of a batch)."""
+    pred = jnp.asarray(pred)
+    return jax.tree.map(lambda a, b: jnp.where(pred.reshape(pred.shape + (1,) * (jnp.ndim(a) - pred.ndim)), a, b),
+                        on_true, on_false)
 
 
 def numpy_tree(tree):
