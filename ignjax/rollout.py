@@ -21,6 +21,7 @@ trajectory plots and the interaction analyses.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from functools import partial
 
@@ -29,7 +30,7 @@ import jax.numpy as jnp
 
 from ignjax.sim import env as E
 from ignjax.sim import types as T
-from ignjax.sim.compact import masked_map
+from ignjax.sim.compact import chunk_size, first_equal, masked_map
 
 
 @partial(jax.tree_util.register_dataclass, data_fields=["geodesic", "best_direction", "best_col", "best_row", "best_value"],
@@ -131,7 +132,8 @@ def _keys(key: jax.Array, n: int) -> jax.Array:
     return key if key.shape == (n,) else jax.random.split(key, n)
 
 
-def rollout_rows(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.Array, chunk: int | None = None):
+def rollout_rows(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.Array, chunk: int | None = None,
+                 groups: jax.Array | None = None, group_chunk: int | None = None):
     """Run a batch of episodes (leading axis B) with per-row agent parameters.
 
     Row for row the same as :func:`rollout_episode` (tested), organised so
@@ -145,6 +147,17 @@ def rollout_rows(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.
         params: agent parameters with leading axis B (one setting per row).
         keys: (B,) per-episode keys.
         chunk: rows per vectorised call (default: an eighth of the batch).
+        groups: optional (B,) int ids; rows with equal ids must have the same
+            episode spec (a parameter sweep's copies of one episode). The
+            simulator is deterministic, so such rows stay in the same state
+            for as long as they take the same actions: each step, the rows of
+            a group that act alike are simulated once (by their first row)
+            and the others copy the result, so a sweep pays for the distinct
+            trajectories, not for every setting. Exact: the same result as
+            without ``groups``, row for row (tested).
+        group_chunk: rows per vectorised call of the simulator in group mode
+            (default: ``chunk``); size it to the number of distinct
+            trajectories, not to the batch.
 
     Returns:
         (OutcomeRow, Trajectory, final SimState) with leading axis B.
@@ -161,18 +174,34 @@ def rollout_rows(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.
     no_action = jax.tree.map(lambda a: jnp.zeros(a.shape, a.dtype),
                              jax.eval_shape(jax.vmap(act), (params, obs, state.answers, pstate, step_keys[0], priv0))[0])
 
+    def simulate(state, obs, priv, action, moved, sim_chunk):
+        state = E.step_batch(world, state, action, sim_chunk)
+        obs = E.observe_batch(world, state, obs, moved, sim_chunk)
+        priv = masked_map(privileged, ~state.done, state, priv, sim_chunk) if privileged else None
+        return state, obs, priv
+
     def body(carry, k):
-        state, obs, pstate, priv = carry
+        state, obs, pstate, priv, group = carry
         was_done = state.done
         action, pstate = masked_map(act, ~was_done, (params, obs, state.answers, pstate, k, priv), (no_action, pstate), chunk)
-        state = E.step_batch(world, state, action, chunk)
         kind = jnp.where(was_done, -1, jnp.clip(action.kind, 0, 2))
-        obs = E.observe_batch(world, state, obs, kind == T.MOVE, chunk)
-        priv = masked_map(privileged, ~state.done, state, priv, chunk) if privileged else None
+        if group is None:
+            state, obs, priv = simulate(state, obs, priv, action, kind == T.MOVE, chunk)
+        else:
+            # one representative per (group, action); the others are marked done for the
+            # simulator (so it skips them) and then copy their representative's result
+            rep = first_equal((group,) + tuple(jax.tree.leaves(action)), ~was_done)
+            lead = rep == jnp.arange(rep.shape[0])
+            sim = dataclasses.replace(state, done=was_done | ~lead)
+            out = simulate(sim, obs, priv, action, (kind == T.MOVE) & lead, group_chunk)
+            state, obs, priv = jax.tree.map(lambda a: a[rep], out)
+            group = rep
         q = jnp.where((kind == T.ASK), jnp.clip(action.question, 1, 4), 0)
-        return (state, obs, pstate, priv), (state.pose, kind.astype(jnp.int32), q.astype(jnp.int32))
+        return (state, obs, pstate, priv, group), (state.pose, kind.astype(jnp.int32), q.astype(jnp.int32))
 
-    (state, _, _, _), (poses, kinds, qs) = jax.lax.scan(body, (state, obs, pstate, priv0), step_keys)
+    groups = None if groups is None else jnp.asarray(groups, jnp.int32)
+    group_chunk = chunk if group_chunk is None else group_chunk
+    (state, _, _, _, _), (poses, kinds, qs) = jax.lax.scan(body, (state, obs, pstate, priv0, groups), step_keys)
     traj = Trajectory(pose=jnp.concatenate([specs.start[:, None].astype(jnp.float32), jnp.swapaxes(poses, 0, 1)], 1),
                       kind=kinds.T, question=qs.T)
     return jax.vmap(lambda st: E.outcome(world, st))(state), traj, state
@@ -210,7 +239,9 @@ def rollout_sweep(world: E.World, specs: T.EpisodeSpec, agent, params_batch, key
     K = jax.tree.leaves(params_batch)[0].shape[0]
     rows = jax.tree.map(lambda x: jnp.repeat(x, n, axis=0), params_batch)
     tile = jnp.tile(jnp.arange(n), K)
-    out = rollout_rows(world, jax.tree.map(lambda a: a[tile], specs), agent, rows, keys[tile], chunk)[:2]
+    sim_chunk = chunk if chunk is not None else chunk_size(n)
+    out = rollout_rows(world, jax.tree.map(lambda a: a[tile], specs), agent, rows, keys[tile], chunk,
+                       groups=tile, group_chunk=sim_chunk)[:2]
     return jax.tree.map(lambda a: a.reshape((K, n) + a.shape[1:]), out)
 
 

@@ -10,6 +10,7 @@ shape per agent) with the per-episode keys of :func:`ignjax.rollout.episode_keys
 from __future__ import annotations
 
 import dataclasses
+from functools import partial
 
 import chex
 import jax
@@ -240,3 +241,30 @@ def test_batched_rollout_equals_one_episode_rollout(small_benchmark, small_world
                   compiler_options=ROLLOUT_COMPILER_OPTIONS)(specs, keys)
     same = _rows_matching(got, ref)
     assert same.mean() >= 0.95, f"{name}: {int((~same).sum())} of {same.size} episodes differ: {np.flatnonzero(~same)}"
+
+
+def test_sweep_simulates_each_distinct_trajectory_once_with_the_same_result(small_benchmark, small_world, runs):
+    """rollout_sweep simulates the settings of an episode that act alike once
+    (group mode); the result equals every row simulated on its own, exactly
+    (same chunk width in both, so the same vectorised code runs per row)."""
+    from ignjax.rollout import ROLLOUT_COMPILER_OPTIONS, rollout_rows
+
+    es = small_benchmark["set"]
+    specs, keys = _batch(es)
+    eig, params = get_agent("eig"), runs["eig_params"]
+    n, K = specs.scene.shape[0], len(SCALES)
+
+    @partial(jax.jit, compiler_options=ROLLOUT_COMPILER_OPTIONS)
+    def each_row(specs, params, keys):
+        tile = jnp.tile(jnp.arange(n), K)
+        rows = jax.tree.map(lambda x: jnp.repeat(x, n, axis=0), params)
+        out = rollout_rows(small_world, jax.tree.map(lambda a: a[tile], specs), eig, rows, keys[tile], 8)[:2]
+        return jax.tree.map(lambda a: a.reshape((K, n) + a.shape[1:]), out)
+
+    want = jax.tree.map(np.asarray, each_row(specs, params, keys))
+    got = jax.tree.map(np.asarray, rollout_sweep(small_world, specs, eig, params, keys, chunk=8))
+    chex.assert_trees_all_equal(got, want)
+    # the settings do share work: in most episodes two settings take the same first actions
+    first = want[1].kind[:, :, :2] * 5 + want[1].question[:, :, :2]
+    shared = np.any([np.all(first[i] == first[j], axis=1) for i in range(K) for j in range(i)], axis=0)
+    assert shared.mean() > 0.5, shared.mean()

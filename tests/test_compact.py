@@ -7,7 +7,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from ignjax.sim.compact import chunk_size, masked_map
+from ignjax.sim.compact import chunk_size, first_equal, masked_map
 
 
 def _fn(x):
@@ -53,3 +53,19 @@ def test_masked_map_runs_fn_only_on_the_chunks_it_needs():
 
 def test_chunk_size():
     assert chunk_size(1) == 1 and chunk_size(8) == 1 and chunk_size(9) == 2 and chunk_size(4096) == 512
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_first_equal_is_the_first_masked_row_with_equal_keys(seed):
+    rng = np.random.default_rng(seed)
+    B = 50
+    keys = [rng.integers(0, 3, B), rng.integers(-1, 2, B), rng.random(B) < 0.5]
+    mask = rng.random(B) < 0.8
+    got = np.asarray(jax.jit(first_equal)([jnp.asarray(k) for k in keys], jnp.asarray(mask)))
+    for r in range(B):
+        if not mask[r]:
+            assert got[r] == r
+            continue
+        same = [s for s in range(B) if mask[s] and all(k[s] == k[r] for k in keys)]
+        assert got[r] == same[0], (r, got[r], same)
+    assert np.all(got[got] == got)

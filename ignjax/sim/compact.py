@@ -56,3 +56,29 @@ def masked_map(fn, mask, args, default, chunk: int | None = None):
             out, vals)
 
     return jax.lax.fori_loop(0, trips, body, default)
+
+
+def first_equal(keys, mask):
+    """For each row, the smallest index of a ``mask``-ed row whose ``keys``
+    all equal its own; rows outside ``mask`` map to themselves.
+
+    Args:
+        keys: sequence of (B,) integer or bool arrays, compared exactly.
+        mask: (B,) bool rows that take part.
+
+    Returns:
+        (B,) int32 representative index per row: ``rep[rep] == rep``, and two
+        masked rows share a representative exactly when their keys are equal.
+    """
+    B = mask.shape[0]
+    iota = jnp.arange(B, dtype=jnp.int32)
+    ops = [(~mask).astype(jnp.int32)] + [jnp.asarray(k).astype(jnp.int32) for k in keys] + [iota]
+    srt = jax.lax.sort(ops, num_keys=len(ops) - 1, is_stable=True)
+    key_sorted, order = srt[:-1], srt[-1]
+    differs = jnp.zeros(B - 1, bool)
+    for k in key_sorted:
+        differs = differs | (k[1:] != k[:-1])
+    start = jnp.concatenate([jnp.ones(1, bool), differs])
+    run_start = jax.lax.cummax(jnp.where(start, iota, 0))
+    rep = jnp.zeros(B, jnp.int32).at[order].set(order[run_start], unique_indices=True)
+    return jnp.where(mask, rep, iota)
