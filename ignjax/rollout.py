@@ -30,7 +30,7 @@ import jax.numpy as jnp
 
 from ignjax.sim import env as E
 from ignjax.sim import types as T
-from ignjax.sim.compact import chunk_size, first_equal, masked_map
+from ignjax.sim.compact import chunk_size, even_chunk, first_equal, masked_map
 
 
 @partial(jax.tree_util.register_dataclass, data_fields=["geodesic", "best_direction", "best_col", "best_row", "best_value"],
@@ -137,11 +137,13 @@ def rollout_rows(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.
     """Run a batch of episodes (leading axis B) with per-row agent parameters.
 
     Row for row the same as :func:`rollout_episode` (tested), organised so
-    the batch pays for the work its episodes need: the agent acts for the
-    unfinished rows only, the executor runs for the rows that MOVE, the
+    the batch pays for the work its episodes need: the executor runs for the rows that MOVE, the
     oracle for the rows that ASK, and the perception is recomputed for the
     rows that moved (:func:`ignjax.sim.env.step_batch`,
     :func:`ignjax.sim.env.observe_batch`, :func:`ignjax.sim.compact.masked_map`).
+    The agent decides for every row, in contiguous chunks: moving the
+    unfinished rows' memory in and out of compacted chunks costs more than
+    the finished rows' (ignored) decisions.
 
     Args:
         params: agent parameters with leading axis B (one setting per row).
@@ -171,8 +173,7 @@ def rollout_rows(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.
     privileged = (lambda st: privileged_info(world, st)) if agent.privileged else None
     priv0 = jax.vmap(privileged)(state) if privileged else None
     act = lambda x: agent.act(*x)  # noqa: E731
-    no_action = jax.tree.map(lambda a: jnp.zeros(a.shape, a.dtype),
-                             jax.eval_shape(jax.vmap(act), (params, obs, state.answers, pstate, step_keys[0], priv0))[0])
+    act_chunk = even_chunk(keys.shape[0], chunk or chunk_size(keys.shape[0]))
 
     def simulate(state, obs, priv, action, moved, sim_chunk):
         state = E.step_batch(world, state, action, sim_chunk)
@@ -183,7 +184,9 @@ def rollout_rows(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.
     def body(carry, k):
         state, obs, pstate, priv, group = carry
         was_done = state.done
-        action, pstate = masked_map(act, ~was_done, (params, obs, state.answers, pstate, k, priv), (no_action, pstate), chunk)
+        # every row decides, in contiguous chunks (a finished row's decision is ignored): compacting the
+        # unfinished rows would gather and scatter the agents' whole memory every step, which costs more
+        action, pstate = jax.lax.map(act, (params, obs, state.answers, pstate, k, priv), batch_size=act_chunk)
         kind = jnp.where(was_done, -1, jnp.clip(action.kind, 0, 2))
         if group is None:
             state, obs, priv = simulate(state, obs, priv, action, kind == T.MOVE, chunk)

@@ -7,7 +7,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from ignjax.sim.compact import chunk_size, first_equal, masked_map
+from ignjax.sim.compact import chunk_size, even_chunk, first_equal, masked_map
 
 
 def _fn(x):
@@ -69,3 +69,10 @@ def test_first_equal_is_the_first_masked_row_with_equal_keys(seed):
         same = [s for s in range(B) if mask[s] and all(k[s] == k[r] for k in keys)]
         assert got[r] == same[0], (r, got[r], same)
     assert np.all(got[got] == got)
+
+
+def test_even_chunk_divides_the_rows_when_it_can():
+    assert even_chunk(4096, 512) == 512
+    assert even_chunk(500, 63) == 50 and 500 % 50 == 0
+    assert even_chunk(97, 13) == 13  # a prime: no divisor in [7, 13], the chunk itself
+    assert even_chunk(10, 40) == 10

@@ -25,6 +25,18 @@ def chunk_size(n_rows: int, chunks: int = CHUNKS) -> int:
     return max(1, -(-int(n_rows) // int(chunks)))
 
 
+def even_chunk(n_rows: int, chunk: int) -> int:
+    """A chunk size near ``chunk`` that divides ``n_rows`` (the largest
+    divisor in [chunk / 2, chunk]), so a chunked map over all rows
+    (``lax.map`` with ``batch_size``) has no remainder call to compile;
+    ``chunk`` itself when there is none."""
+    chunk = max(1, min(int(chunk), int(n_rows)))
+    for c in range(chunk, (chunk + 1) // 2 - 1, -1):
+        if n_rows % c == 0:
+            return c
+    return chunk
+
+
 def masked_map(fn, mask, args, default, chunk: int | None = None):
     """``where(mask, vmap(fn)(args), default)``, computing ``fn`` on the selected rows only.
 
