@@ -268,3 +268,19 @@ def test_sweep_simulates_each_distinct_trajectory_once_with_the_same_result(smal
     first = want[1].kind[:, :, :2] * 5 + want[1].question[:, :, :2]
     shared = np.any([np.all(first[i] == first[j], axis=1) for i in range(K) for j in range(i)], axis=0)
     assert shared.mean() > 0.5, shared.mean()
+
+
+def test_visit_counts_saturate_instead_of_wrapping(small_benchmark, small_world):
+    from ignjax.agents.base import Memory, _visit_index, observe_memory
+    from ignjax.sim import env as E
+
+    spec = jax.tree.map(lambda a: a[0], small_benchmark["set"].specs)
+    obs = E.observe(small_world, E.reset(small_world, spec))
+    ij = np.asarray(_visit_index(obs.odometry[:2]))
+    mem = Memory.empty()
+    once = observe_memory(mem, obs)
+    assert int(once.visits[ij[1], ij[0]]) == 1 and int(once.visits.sum()) == 1
+    full = dataclasses.replace(mem, visits=mem.visits.at[ij[1], ij[0]].set(254))
+    for _ in range(2):
+        full = observe_memory(full, obs)
+    assert int(full.visits[ij[1], ij[0]]) == 255

@@ -42,6 +42,7 @@ from ignjax.sim.geometry import wrap_angle
 N_LABELS = len(vocab.ALL_ROOM_LABELS)
 VISIT_CELL = 0.5
 VISIT_SIZE = 64
+VISIT_DTYPE = jnp.uint8  # visit counts saturate at 255; a cell is counted once per decision
 MAX_CANDIDATES = 12
 
 
@@ -81,7 +82,10 @@ class Memory:
     """Scripted agents' memory (one episode).
 
     Attributes:
-        visits: (G, G) int32 visit counts of odometry-frame cells.
+        visits: (G, G) uint8 visit counts of odometry-frame cells (a cell
+            is counted at most once per decision; counts saturate at 255). A
+            quarter of the int32 grid's bytes: this grid is most of the
+            memory every rollout step moves per episode.
         handle: (M,) int32 instance handle of each candidate slot (-1 empty).
         pos: (M, 2) float32 estimated candidate positions, odometry frame.
         attrs: (M, 4) int32 observed colour/material/size/state codes.
@@ -121,7 +125,7 @@ class Memory:
     @staticmethod
     def empty() -> "Memory":
         M = MAX_CANDIDATES
-        return Memory(visits=jnp.zeros((VISIT_SIZE, VISIT_SIZE), jnp.int32), handle=jnp.full(M, -1, jnp.int32),
+        return Memory(visits=jnp.zeros((VISIT_SIZE, VISIT_SIZE), VISIT_DTYPE), handle=jnp.full(M, -1, jnp.int32),
                       pos=jnp.zeros((M, 2), jnp.float32), attrs=jnp.full((M, 4), -1, jnp.int32),
                       room=jnp.full(M, -1, jnp.int32), logw=jnp.zeros(M, jnp.float32), rejected=jnp.zeros(M, bool),
                       unseen_logw=jnp.zeros((N_LABELS, 8), jnp.float32), hint_heading=jnp.float32(0.0), has_hint=jnp.array(False),
@@ -140,7 +144,8 @@ def observe_memory(mem: Memory, obs: T.Observation, colour_known=None, room_know
     the log-likelihood of the Type-1 colour and Type-2 room answers already
     received (``colour_known`` / ``room_known``: () int32 codes or -1)."""
     ij = _visit_index(obs.odometry[:2])
-    visits = mem.visits.at[ij[1], ij[0]].add(1)
+    v = mem.visits[ij[1], ij[0]]
+    visits = mem.visits.at[ij[1], ij[0]].set(jnp.where(v < jnp.iinfo(v.dtype).max, v + 1, v))
     colour_known = jnp.int32(-1) if colour_known is None else colour_known
     room_known = jnp.int32(-1) if room_known is None else room_known
 
