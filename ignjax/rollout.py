@@ -137,9 +137,9 @@ def rollout_rows(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.
     """Run a batch of episodes (leading axis B) with per-row agent parameters.
 
     Row for row the same as :func:`rollout_episode` (tested), organised so
-    the batch pays for the work its episodes need: the executor runs for the rows that MOVE, the
-    oracle for the rows that ASK, and the perception is recomputed for the
-    rows that moved (:func:`ignjax.sim.env.step_batch`,
+    the batch pays for the work its episodes need: the executor runs for the
+    rows that MOVE, the oracle for the rows that ASK, and the perception is
+    recomputed for the rows that moved (:func:`ignjax.sim.env.step_batch`,
     :func:`ignjax.sim.env.observe_batch`, :func:`ignjax.sim.compact.masked_map`).
     The agent decides for every row, in contiguous chunks: moving the
     unfinished rows' memory in and out of compacted chunks costs more than
