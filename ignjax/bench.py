@@ -63,7 +63,7 @@ def bench_rays(quick: bool) -> dict:
     grid = build_navgrid(compiled)
     compile_s = time.perf_counter() - t0
     n = 16_384 if quick else 65_536
-    r = benchmark_rays(compiled, grid, n_rays=n, max_dist=5.0, repeat=2 if quick else 3)
+    r = benchmark_rays(compiled, grid, n_rays=n, max_dist=5.0, repeat=4 if quick else 5)
     # the rollouts' depth ray on the same kind of rays
     rng = np.random.default_rng(0)
     pnts, vecs = random_rays(grid, n // 32, 32, rng, heights=(0.1, 2.0))

@@ -45,8 +45,9 @@ def episode_batches(es: EpisodeSet, batch: int, seed: int = 0, progress=None):
 
 
 def run_agent(es: EpisodeSet, agent: Agent | str, *, params=None, batch: int = 256, seed: int = 0,
-              config: SimConfig = SimConfig(), progress=None, world: World | None = None):
-    """Roll out every episode of ``es`` with one agent.
+              config: SimConfig = SimConfig(), progress=None, world: World | None = None, parts: int | None = None):
+    """Roll out every episode of ``es`` with one agent, ``batch`` episodes per
+    rollout, each run as ``parts`` concurrent pieces (:func:`ignjax.rollout.batch_parts`).
 
     Returns:
         (OutcomeRow, Trajectory) as numpy pytrees with leading axis len(es).
@@ -57,7 +58,7 @@ def run_agent(es: EpisodeSet, agent: Agent | str, *, params=None, batch: int = 2
     check_specs(world, es.specs)
     outs = []
     for n_real, specs, keys in episode_batches(es, batch, seed, progress):
-        out, traj = rollout(world, specs, agent, params, keys)
+        out, traj = rollout(world, specs, agent, params, keys, parts=parts)
         outs.append(jax.tree.map(lambda a, m=n_real: np.asarray(a)[:m], (out, traj)))
     return jax.tree.map(lambda *xs: np.concatenate(xs), *outs)
 

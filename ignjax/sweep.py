@@ -235,7 +235,7 @@ def run_eval_stage(es, world, agent_name: str, cfg: dict, ckpt: Checkpoints, bar
                 bar.update(min(cfg["eval"]["batch"], len(es) - c))
 
     out, traj = run_agent(es, agent_name, batch=cfg["eval"]["batch"], seed=cfg["run"]["seed"], world=world,
-                          progress=prog)
+                          progress=prog, parts=cfg["eval"]["parts"] or None)
     tree = {"out": _to_tree(out), "traj": _to_tree(traj)}
     ckpt.save(name, tree)
     return tree
@@ -283,7 +283,7 @@ def run_costs_stage(es, world, cfg: dict, ckpt: Checkpoints, bar=None) -> dict:
     batch = max(1, cfg["eval"]["batch"] // max(1, K // 4))
     parts = []
     for n_real, specs, keys in episode_batches(es, batch, cfg["run"]["seed"]):
-        out, _ = rollout_sweep(world, specs, agent, params, keys)
+        out, _ = rollout_sweep(world, specs, agent, params, keys, parts=cfg["eval"]["parts"] or None)
         parts.append({k: v[:, :n_real] for k, v in _to_tree(out).items()})
         if bar is not None:
             bar.update(n_real * K)

@@ -37,6 +37,7 @@ DEFAULTS: dict[str, dict[str, Any]] = {
     "eval": {
         "agents": ["random", "explorer", "naive_asker", "eig", "shortest_path"],
         "batch": 256,
+        "parts": 0,  # concurrent pieces of each batch (0: ignjax.rollout.batch_parts, 2 on CPU)
         "thresholds": [0.5, 1.5, 3.0],
         "costs": [0.182, 0.162, 0.240, 0.103],
         "require_stop": True,
@@ -218,6 +219,8 @@ def validate(cfg: dict) -> None:
         raise ConfigError(None, "difficulty.empty", "must be 'unordered' or 'skip'")
     if cfg["eval"]["batch"] < 1:
         raise ConfigError(None, "eval.batch", "must be >= 1")
+    if cfg["eval"]["parts"] < 0:
+        raise ConfigError(None, "eval.parts", f"must be >= 0 (0: the default split), got {cfg['eval']['parts']}")
     if sorted(cfg["eval"]["thresholds"]) != cfg["eval"]["thresholds"] or any(t <= 0 for t in cfg["eval"]["thresholds"]):
         raise ConfigError(None, "eval.thresholds", "must be positive and increasing")
     lam = cfg["derive-costs"]["lambdas"]

@@ -941,13 +941,18 @@ def agreement(d_fast, d_exact, max_dist: float, tol: float) -> np.ndarray:
     return both | neither | (edge & (hf != he))
 
 
-def _time(fn, repeat: int = 3) -> float:
-    fn()
-    best = math.inf
-    for _ in range(repeat):
-        t0 = time.perf_counter()
+def _time_interleaved(fns: Sequence, repeat: int = 3) -> list[float]:
+    """Best-of-``repeat`` seconds of each function after a warm-up, the
+    functions taking turns in every round, so that a machine whose speed
+    drifts (a shared VM) slows each of them alike and their ratios hold."""
+    for fn in fns:
         fn()
-        best = min(best, time.perf_counter() - t0)
+    best = [math.inf] * len(fns)
+    for _ in range(repeat):
+        for i, fn in enumerate(fns):
+            t0 = time.perf_counter()
+            fn()
+            best[i] = min(best[i], time.perf_counter() - t0)
     return best
 
 
@@ -964,7 +969,7 @@ def benchmark_rays(compiled, grid: NavGrid, n_rays: int = 100_000, max_dist: flo
     ``mjx.ray`` (vmapped, jitted; it ignores cylinders), the exact path
     (:func:`exact_rays`: ``mjx.ray`` plus cylinders) and ``mj_multiRay``.
     Times are the best of ``repeat`` runs after a warm-up (compilation
-    excluded). Agreement is measured against ``mj_multiRay`` with
+    excluded), the four paths taking turns in every round. Agreement is measured against ``mj_multiRay`` with
     :func:`agreement` at a tolerance of one grid cell.
 
     Returns:
@@ -1005,10 +1010,7 @@ def benchmark_rays(compiled, grid: NavGrid, n_rays: int = 100_000, max_dist: flo
             res.append(mj_multiray(compiled, pnts[i * per_origin], vecs[sl], groups, cutoff=max_dist)[0])
         out["multi"] = np.concatenate(res)
 
-    t_fast = _time(run_fast, repeat)
-    t_raw = _time(run_raw, repeat)
-    t_exact = _time(run_exact, repeat)
-    t_multi = _time(run_multi, repeat)
+    t_fast, t_raw, t_exact, t_multi = _time_interleaved((run_fast, run_raw, run_exact, run_multi), repeat)
     ref = out["multi"]
     agree = agreement(np.asarray(out["fast"]), ref, max_dist, grid.resolution)
     agree_exact = agreement(np.asarray(out["exact"]), ref, max_dist, 1e-3)
