@@ -15,7 +15,9 @@ process, on the same inputs:
 * **decision steps/s** - full rollouts (simulation + agent + oracle +
   accounting, no rendering) on the shipped benchmark for each JAX-native
   agent at B = 256, 1024, 4096 episodes; a decision step is one MOVE, ASK
-  or STOP of an unfinished episode (best of three compiled calls).
+  or STOP of an unfinished episode (best of three compiled calls). Each
+  batch runs as the default concurrent pieces (``rollout_parts``,
+  :func:`ignjax.rollout.batch_parts`).
 * **compile_s** - first call of the EIG agent's rollout at B = 256.
 * **studies** - offline WSR of 10^6 cost vectors x 500 episodes, and the
   in-the-loop sweep (the EIG agent under K cost vectors x 500 episodes in
@@ -236,7 +238,12 @@ def main(argv=None) -> int:
     world = make_world(es)
     _log("decision steps ...")
     agents = ("random", "eig") if args.quick else AGENTS
-    res["steps_per_s"], res["compile_s"] = bench_steps(es, world, agents, (256, 1024, 4096))
+    from ignjax.rollout import batch_parts
+
+    sizes = (256, 1024, 4096)
+    res["rollout_parts"] = {str(B): batch_parts(B) for B in sizes}
+    _log("  each batch runs as " + ", ".join(f"{v} pieces at B = {k}" for k, v in res["rollout_parts"].items()))
+    res["steps_per_s"], res["compile_s"] = bench_steps(es, world, agents, sizes)
     _log(f"  EIG rollout compile {res['compile_s']:.1f} s")
     _log("studies ...")
     res["studies"] = bench_studies(es, world, args.quick)

@@ -5,9 +5,11 @@ of observe -> act -> step; finished episodes stay finished);
 :func:`rollout_rows` runs a batch of them with the same results row for row,
 paying only for the work each step's episodes need (the executor for the
 rows that MOVE, the oracle for the rows that ASK, nothing for finished
-rows); :func:`rollout` jits it once per (agent, batch shape), and
+rows); :func:`rollout` jits it once per (agent, piece shape), and
 :func:`rollout_sweep` runs K agent parameter settings x E episodes as one
-batch of K E rows (e.g. K cost vectors in one call).
+batch of K E rows (e.g. K cost vectors in one call). Both run a batch as
+concurrent pieces on CPU (:func:`batch_parts`), since XLA:CPU gives the
+body of a scan one core.
 
 Agents are pure functions (:class:`ignjax.agents.base.Agent`): ``init`` and
 ``act`` see the :class:`~ignjax.sim.types.Observation` and the oracle's
@@ -22,9 +24,9 @@ trajectory plots and the interaction analyses.
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
 import threading
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
 from functools import partial
 
 import jax
@@ -175,6 +177,8 @@ def _executable(jitted, dynamic: tuple, static: dict):
 
 def _pool(n: int) -> ThreadPoolExecutor:
     if not _POOL or _POOL[0]._max_workers < n:
+        if _POOL:
+            _POOL[0].shutdown(wait=False)
         _POOL[:] = [ThreadPoolExecutor(n, thread_name_prefix="ignjax-rollout")]
     return _POOL[0]
 
@@ -311,7 +315,7 @@ def rollout(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.Array
             parts: int | None = None):
     """Run a batch of episodes (leading axis E of ``specs``) with one agent.
 
-    One jitted program (compiled once per agent and batch shape); the batch
+    One jitted program, compiled once per agent and piece shape: the batch
     runs as ``parts`` equal pieces at the same time (:func:`batch_parts`).
 
     Args:
