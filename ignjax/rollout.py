@@ -137,11 +137,11 @@ def batch_parts(n_rows: int, parts: int | None = None) -> int:
     XLA:CPU runs the body of a rollout's scan on one core, so a batch runs
     fastest as several pieces executed at once (the EIG agent at B = 4096 on
     a 2-core CPU: 1.7x). The default depends on the batch and the backend
-    only, never on the machine, so that a configuration gives the same bytes
-    everywhere: :data:`PARTS` pieces on CPU when each gets at least
-    :data:`MIN_PART_ROWS` rows, one otherwise and on accelerators (where one
-    program fills the device). Machines with more cores profit from more
-    pieces (``parts``). Each piece is the same compiled program; a row's
+    only, never on the machine's core count, so that a configuration
+    compiles the same shapes everywhere: :data:`PARTS` pieces on CPU when
+    each gets at least :data:`MIN_PART_ROWS` rows, one otherwise and on
+    accelerators (where one program fills the device). Machines with more
+    cores profit from more pieces (``parts``). Each piece is the same compiled program; a row's
     result depends on its episode, key and agent parameters, and, through
     float rounding in rare rows, on the piece's shape (as on the chunk size).
 
