@@ -3,8 +3,9 @@
 
 Episodes are run in chunks of ``batch`` (the last chunk padded with masked
 copies), so every chunk reuses one compiled rollout; each episode's PRNG key
-comes from the seed and its index in the episode file, so results do not
-depend on the batch size.
+comes from the seed and its index in the episode file, so its randomness
+does not depend on the batch size (float rounding can, in rare episodes:
+see :func:`ignjax.rollout.batch_parts`).
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ import numpy as np
 
 from ignjax.agents.base import Agent, get_agent
 from ignjax.episodes.batch import EpisodeSet
-from ignjax.rollout import episode_keys, pad_specs, rollout
+from ignjax.rollout import episode_keys, pad_batch, rollout
 from ignjax.sim.env import World, check_specs
 from ignjax.sim.types import SimConfig
 
@@ -38,9 +39,7 @@ def episode_batches(es: EpisodeSet, batch: int, seed: int = 0, progress=None):
         idx = np.arange(start, min(start + batch, n))
         specs = jax.tree.map(lambda a: a[idx], es.specs)
         keys = keys_all[idx]
-        if len(idx) < batch:
-            specs = pad_specs(specs, batch)
-            keys = jax.numpy.concatenate([keys, jax.numpy.repeat(keys[-1:], batch - len(idx))])
+        specs, keys = pad_batch(specs, keys, batch)
         yield len(idx), specs, keys
 
 

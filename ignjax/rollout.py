@@ -141,9 +141,10 @@ def batch_parts(n_rows: int, parts: int | None = None) -> int:
     compiles the same shapes everywhere: :data:`PARTS` pieces on CPU when
     each gets at least :data:`MIN_PART_ROWS` rows, one otherwise and on
     accelerators (where one program fills the device). Machines with more
-    cores profit from more pieces (``parts``). Each piece is the same compiled program; a row's
-    result depends on its episode, key and agent parameters, and, through
-    float rounding in rare rows, on the piece's shape (as on the chunk size).
+    cores profit from more pieces (``parts``). Each piece is the same
+    compiled program; a row's result depends on its episode, key and agent
+    parameters, and, through float rounding in rare rows, on the piece's
+    shape (as on the chunk size).
 
     Args:
         n_rows: rows of the batch.
@@ -192,8 +193,7 @@ def _in_parts(jitted, world, specs, agent, params, keys, chunk, parts: int, out_
     if parts <= 1 or any(isinstance(x, jax.core.Tracer) for x in jax.tree.leaves(dynamic)):
         return jitted(world, specs, agent, params, keys, chunk)
     size = -(-n // parts)
-    specs = pad_specs(specs, size * parts)
-    keys = jnp.concatenate([keys, jnp.repeat(keys[-1:], size * parts - n)]) if size * parts > n else keys
+    specs, keys = pad_batch(specs, keys, size * parts)
     pieces = [(world, jax.tree.map(lambda a: a[i * size:(i + 1) * size], specs), params, keys[i * size:(i + 1) * size])
               for i in range(parts)]
     exe = _executable(jitted, pieces[0], {"agent": agent, "chunk": chunk})
@@ -356,8 +356,14 @@ def pad_specs(specs: T.EpisodeSpec, size: int) -> T.EpisodeSpec:
     n = specs.scene.shape[0]
     if n >= size:
         return specs
-    import dataclasses
-
     idx = jnp.concatenate([jnp.arange(n), jnp.full(size - n, n - 1)])
     out = jax.tree.map(lambda a: a[idx], specs)
     return dataclasses.replace(out, valid=jnp.arange(size) < n)
+
+
+def pad_batch(specs: T.EpisodeSpec, keys: jax.Array, size: int) -> tuple[T.EpisodeSpec, jax.Array]:
+    """:func:`pad_specs`, and the (E,) keys padded alike (copies of the last key)."""
+    n = keys.shape[0]
+    if n < size:
+        keys = jnp.concatenate([keys, jnp.repeat(keys[-1:], size - n)])
+    return pad_specs(specs, size), keys
