@@ -38,7 +38,7 @@ def make_two_room_scene():
     (living room, facing the table), ``chair_2`` (bedroom), ``painting_0``
     (living room north wall).
     """
-    from ignjax.scenes import catalogue as cat
+    from ignjax.scenes.procgen import catalogue as cat
     from ignjax.scenes.model import Attributes, Door, Room, Scene, SceneMeta, Wall
 
     rng = np.random.default_rng(0)
@@ -90,12 +90,12 @@ def small_benchmark(tmp_path_factory):
     """A small benchmark built end to end, shared by the simulator, agent and
     study tests: two procedural houses (3 and 5 rooms) written as USD, a
     40-episode balanced subset written as an episode file, and the loaded
-    :class:`~ignjax.episodes.batch.EpisodeSet`."""
-    from ignjax.episodes.batch import load_benchmark
+    :class:`~ignjax.episodes.dataset.EpisodeSet`."""
+    from ignjax.episodes.dataset import load_benchmark
     from ignjax.episodes.construct import BuildConfig, build_benchmark
     from ignjax.episodes.schema import construction_path, write_records
-    from ignjax.scenes.procgen import HouseParams, generate_house
-    from ignjax.scenes.usd import save_usd
+    from ignjax.scenes.procgen.generate import HouseParams, generate_house
+    from ignjax.scenes.io.usd import save_usd
 
     root = tmp_path_factory.mktemp("bench")
     houses = [generate_house(11, HouseParams(n_rooms=3), "small_a"), generate_house(12, HouseParams(n_rooms=5), "small_b")]

@@ -8,7 +8,7 @@ An :class:`Agent` is a pair of pure functions::
 written for one episode (vmapped by the rollout). ``obs`` is an
 :class:`~ignjax.sim.types.Observation`, ``answers`` the oracle's
 :class:`~ignjax.sim.types.Answer`; ``priv`` is
-:class:`~ignjax.rollout.Privileged` for agents with ``privileged=True`` and
+:class:`~ignjax.sim.rollout.Privileged` for agents with ``privileged=True`` and
 None for every other agent. ``params`` is a pytree the rollout can vmap
 over (e.g. per-type cost vectors for in-the-loop sweeps).
 

@@ -65,7 +65,7 @@ import jax.numpy as jnp
 from ignjax.agents.base import (
     Agent, Memory, candidate_relative, explore_direction, move_toward, observe_memory, pytree_dataclass,
 )
-from ignjax.metrics import LOCKED_COSTS
+from ignjax.evaluate.metrics import LOCKED_COSTS
 from ignjax.scenes import vocab
 from ignjax.sim import types as T
 

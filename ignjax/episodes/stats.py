@@ -138,7 +138,7 @@ def statistics_figure(corpus: dict, subset: dict | None, path: str | os.PathLike
 
     fig.suptitle(title)
     fig.tight_layout()
-    from ignjax.scenes.mapplot import save_figure
+    from ignjax.scenes.viz.mapplot import save_figure
 
     save_figure(fig, path, 110)
     return fig

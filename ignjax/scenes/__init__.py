@@ -3,9 +3,9 @@
 * :mod:`~ignjax.scenes.model`: the typed host-side scene model.
 * :mod:`~ignjax.scenes.vocab`: room labels, categories, attributes.
 * :mod:`~ignjax.scenes.graph`: the derived room-object graph.
-* :mod:`~ignjax.scenes.io`: read any supported source (:func:`load_scenes`).
-* :mod:`~ignjax.scenes.procgen` / :mod:`~ignjax.scenes.catalogue`: procedural houses.
-* :mod:`~ignjax.scenes.usd`, :mod:`~ignjax.scenes.procthor`, :mod:`~ignjax.scenes.meshes`: importers (and USD export).
+* :mod:`~ignjax.scenes.io.sources`: read any supported source (:func:`load_scenes`).
+* :mod:`~ignjax.scenes.procgen.generate` / :mod:`~ignjax.scenes.procgen.catalogue`: procedural houses.
+* :mod:`~ignjax.scenes.io.usd`, :mod:`~ignjax.scenes.io.procthor`, :mod:`~ignjax.scenes.io.meshes`: importers (and USD export).
 * :mod:`~ignjax.scenes.compile`, :mod:`~ignjax.scenes.navgrid`, :mod:`~ignjax.scenes.bank`: MuJoCo/MJX models, navigation grids, the SceneBank.
 """
 

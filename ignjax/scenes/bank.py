@@ -10,7 +10,7 @@ grid is copied per episode.
 
 Padding never creates a path or a hit: padded grid cells are not navigable,
 have room -1 and component -1; the fast ray caster clips each ray to its own
-scene's grid extent (:class:`~ignjax.sim.raycast.RayGrid`); padded instances,
+scene's grid extent (:class:`~ignjax.sim.rays.caster.RayGrid`); padded instances,
 rooms and doors have ``valid = False`` and index -1 everywhere.
 
 Static metadata (not pytree leaves): scene ids, the category vocabulary, the
@@ -34,7 +34,7 @@ from ignjax.scenes.compile import CompileOptions, CompiledScene, compile_scene
 from ignjax.scenes.graph import room_adjacency
 from ignjax.scenes.model import Scene
 from ignjax.scenes.navgrid import GridConfig, NavGrid, build_navgrid, check_reachable, geodesic_field, seeds_from_box
-from ignjax.sim.raycast import RayGrid, ray_grid
+from ignjax.sim.rays.caster import RayGrid, ray_grid
 
 
 @partial(jax.tree_util.register_dataclass,
@@ -140,7 +140,7 @@ class SceneBank:
     """Many scenes as one pytree (see the module docstring).
 
     Attributes:
-        rays: fast ray caster arrays (:class:`~ignjax.sim.raycast.RayGrid`).
+        rays: fast ray caster arrays (:class:`~ignjax.sim.rays.caster.RayGrid`).
         grid: navigation grids (:class:`GridTable`).
         instances: instance table (:class:`InstanceTable`).
         rooms: room table (:class:`RoomTable`).

@@ -63,7 +63,7 @@ class CompileOptions:
     Attributes:
         floor_margin: how far the visible floor extends beyond the scene, m.
         offscreen_size: (width, height) of MuJoCo's offscreen buffer; the
-            largest image :mod:`ignjax.sim.render` can produce.
+            largest image :mod:`ignjax.scenes.viz.render` can produce.
         shadows: whether the lights cast shadows (slower to render).
     """
 

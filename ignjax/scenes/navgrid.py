@@ -4,7 +4,7 @@
 into a :class:`NavGrid` (host-side numpy arrays): a voxel occupancy of every
 non-floor geom, height-band occupancy, the navigable mask, a room-id grid,
 connected components, and the acceleration structures of the fast ray caster
-(:mod:`ignjax.sim.raycast`). :func:`geodesic_field` is the JAX array program
+(:mod:`ignjax.sim.rays.caster`). :func:`geodesic_field` is the JAX array program
 for geodesic distances on the navigable mask.
 
 Cells

@@ -4,7 +4,7 @@ Batching is ``jax.vmap`` applied once, by the caller; the :class:`World`
 (scene bank + goal fields) is passed unbatched. :func:`step_batch`,
 :func:`execute_moves` and :func:`observe_batch` are the same transitions for
 a batch, organised so that rows pay only for the work they need (used by
-:func:`ignjax.rollout.rollout_rows`); the one-episode :func:`step` is
+:func:`ignjax.sim.rollout.rollout_rows`); the one-episode :func:`step` is
 :func:`step_batch` on a batch of one, so there is one executor.
 
 Protocol (paper §3.3, Appendix C; constants in :class:`~ignjax.sim.types.SimConfig`):
@@ -13,7 +13,7 @@ Protocol (paper §3.3, Appendix C; constants in :class:`~ignjax.sim.types.SimCon
   on STOP or after ``max_steps`` steps; finished episodes stay finished.
 * **MOVE** (view k, cell (col, row)) - the executor takes the cell's centre
   pixel (Eq. grid-to-pixel), casts the pixel's ray (voxel traversal with
-  exact primitive tests, :func:`ignjax.sim.rays.march`) and
+  exact primitive tests, :func:`ignjax.sim.rays.queries.march`) and
   back-projects it with the view's intrinsics and the found depth
   (Eqs. camera-backproject / camera-to-world). A pixel with no valid depth
   within ``depth_range`` falls back to the floor-plane intersection (Eq.
@@ -66,7 +66,7 @@ import numpy as np
 from ignjax.errors import ConfigError
 from ignjax.scenes.bank import SceneBank
 from ignjax.sim import geometry as G
-from ignjax.sim import rays as SR
+from ignjax.sim.rays import queries as SR
 from ignjax.sim import types as T
 from ignjax.sim.compact import masked_map
 

@@ -45,7 +45,7 @@ def new_figure(nrows: int = 1, ncols: int = 1, size=(6.0, 4.0)):
 
 def save(fig, path: str | os.PathLike, dpi: int = 120) -> Path:
     """Write ``fig`` as PNG atomically (temporary name, then rename)."""
-    from ignjax.scenes.mapplot import save_figure
+    from ignjax.scenes.viz.mapplot import save_figure
 
     fig.tight_layout()
     return save_figure(fig, path, dpi=dpi)

@@ -1,8 +1,8 @@
 """Cost sensitivity: WSR re-weighted offline under many question-cost vectors.
 
-WSR (paper Eq. wsr, :mod:`ignjax.metrics`) charges every Type-t question a
+WSR (paper Eq. wsr, :mod:`ignjax.evaluate.metrics`) charges every Type-t question a
 penalty w_t through the discount ``exp(-sum_t w_t n_{e,t})``
-(:func:`ignjax.metrics.question_discount`, reused here unchanged)::
+(:func:`ignjax.evaluate.metrics.question_discount`, reused here unchanged)::
 
     WSR_k(a) = 1/|E_a| sum_{e valid} success_{a,e} * exp(-n_{a,e} . c_k)
 
@@ -51,8 +51,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ignjax import metrics as M
-from ignjax.costs import simplex_grid
+from ignjax.evaluate import metrics as M
+from ignjax.studies.cost_derivation import simplex_grid
 from ignjax.errors import ConfigError, InputError
 from ignjax.studies._common import TYPE_LABELS, as_array, new_figure, save
 
@@ -203,7 +203,7 @@ def offline_wsr(success, n_questions, valid, costs, *, difficulty=None, n_bins: 
 
     Args:
         success: (A, E) or (A, E, T) success flags (bool or 0/1), e.g.
-            :func:`ignjax.metrics.episode_success` per agent.
+            :func:`ignjax.evaluate.metrics.episode_success` per agent.
         n_questions: (A, E, 4) charged questions per type.
         valid: None, (E,) or (A, E) bool, rows that count.
         costs: (4,) or (K, 4) cost vectors (checked by :func:`validate_costs`).

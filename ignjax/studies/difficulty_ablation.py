@@ -25,7 +25,7 @@ import os
 import numpy as np
 from scipy.stats import rankdata
 
-from ignjax.costs import simplex_grid
+from ignjax.studies.cost_derivation import simplex_grid
 from ignjax.episodes.difficulty import DEFAULT_ALPHA, DEFAULT_THRESHOLDS, FACTOR_NAMES, difficulty_score
 from ignjax.errors import ConfigError, InputError
 from ignjax.studies._common import BIN_NAMES, as_array, new_figure, save

@@ -1,0 +1,48 @@
+"""Array helpers shared by every layer: the one pytree-dataclass decorator
+and the numpy / jax.numpy dispatch of functions that accept either."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+
+def pytree_dataclass(cls=None, *, static: tuple[str, ...] = ()):
+    """Make ``cls`` a frozen dataclass registered as a JAX pytree.
+
+    Every field is a pytree leaf (traced, batched by ``vmap``) except those
+    named in ``static``, which are hashable metadata (part of the tree's
+    structure, e.g. a configuration). ``cls`` may already be a dataclass
+    (``@pytree_dataclass`` over ``@dataclass(frozen=True)``); otherwise it is
+    made a frozen one. Use as ``@pytree_dataclass`` or
+    ``@pytree_dataclass(static=("config",))``; change instances with
+    :func:`dataclasses.replace`.
+    """
+
+    def wrap(c):
+        if not dataclasses.is_dataclass(c):
+            c = dataclasses.dataclass(frozen=True)(c)
+        names = [f.name for f in dataclasses.fields(c)]
+        unknown = set(static) - set(names)
+        if unknown:
+            raise TypeError(f"{c.__name__}: static fields {sorted(unknown)} are not fields")
+        return jax.tree_util.register_dataclass(
+            c, data_fields=[n for n in names if n not in static], meta_fields=[n for n in names if n in static])
+
+    return wrap if cls is None else wrap(cls)
+
+
+def xp(*arrays):
+    """``numpy`` when every input is a numpy array or a Python scalar/sequence, else ``jax.numpy``.
+
+    Functions written against the returned namespace run eagerly on host
+    arrays (exact float64 where given) and trace under ``jit``/``vmap``.
+    """
+    host = (np.ndarray, np.generic, int, float, tuple, list)
+    return np if all(isinstance(a, host) for a in arrays) else jnp
+
+
+__all__ = ["pytree_dataclass", "xp"]

@@ -1,0 +1,200 @@
+"""``python -m ignjax.build``: build scenes and benchmarks, inspect sources.
+
+Sub-commands::
+
+    python -m ignjax.build scenes --out DIR [--count N] [--seed S] [--maps]
+    python -m ignjax.build inspect PATH [--json]
+    python -m ignjax.build episodes --scenes PATH... --out FILE.jsonl.gz [--subset N] [--seed S] [--alpha a1,a2,a3,a4]
+    python -m ignjax.build episodes --check FILE
+
+Errors on bad input are printed as one line naming the file, the place in it
+and the reason, and the command exits with status 2 without writing
+half-finished outputs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+from ignjax.errors import ConfigError, IgnjaxError, SceneError
+
+
+def _progress(iterable, total: int, desc: str, quiet: bool):
+    from tqdm.auto import tqdm
+
+    return tqdm(iterable, total=total, desc=desc, disable=quiet, file=sys.stderr, dynamic_ncols=True)
+
+
+def cmd_scenes(args) -> int:
+    """Generate procedural houses, write them as USD plus a manifest."""
+    from ignjax.scenes.procgen import generate as procgen
+    from ignjax.scenes.io.manifest import manifest_entry, write_manifest
+    from ignjax.scenes.io.usd import save_usd
+
+    params = procgen.HouseParams(min_rooms=args.min_rooms, max_rooms=args.max_rooms)
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise ConfigError(out, "--out", "exists and is not a folder")
+    t0 = time.perf_counter()
+    scenes = procgen.generate_houses(args.count, args.seed, params)  # validates count and seed before anything is written
+    out.mkdir(parents=True, exist_ok=True)
+    entries = []
+    for scene in _progress(scenes, len(scenes), "houses", args.quiet):
+        if args.check:
+            from ignjax.scenes.compile import compile_scene
+            from ignjax.scenes.navgrid import GridConfig, build_navgrid, check_reachable
+
+            grid = build_navgrid(compile_scene(scene), GridConfig())
+            check_reachable(scene, grid, scene.id)
+        path = save_usd(scene, out / f"{scene.id}.usda")
+        entries.append(manifest_entry(scene, path))
+        if args.maps:
+            from ignjax.scenes.viz.mapplot import plot_scene_map
+
+            (out / "maps").mkdir(exist_ok=True)
+            plot_scene_map(scene, out / "maps" / f"{scene.id}.png")
+    write_manifest(out, entries, {"seed": args.seed, "count": args.count, "params": params.to_dict()})
+    total = sum(e["instances"] for e in entries)
+    print(f"wrote {len(entries)} houses ({sum(e['rooms'] for e in entries)} rooms, {total} instances) "
+          f"and {out / 'manifest.json'} in {time.perf_counter() - t0:.1f} s")
+    return 0
+
+
+def cmd_inspect(args) -> int:
+    """Summarise any supported scene source."""
+    from ignjax.scenes.io.sources import load_scenes
+    from ignjax.scenes.model import scene_summary
+
+    scenes = load_scenes(args.path)
+    if args.json:
+        if len(scenes) == 1:
+            doc = scene_summary(scenes[0])
+        else:
+            doc = {"source": str(args.path), "scenes": [scene_summary(s) for s in scenes]}
+        sys.stdout.write(json.dumps(doc) + "\n")
+        return 0
+    for s in scenes:
+        cats = s.categories()
+        multi = {c: n for c, n in cats.items() if n > 1}
+        print(f"{s.id}  ({s.meta.source_format}: {s.meta.source})")
+        print(f"  up axis {s.meta.up_axis}, {s.meta.meters_per_unit:g} m/unit; {len(s.rooms)} rooms, {len(s.doors)} doors, "
+              f"{len(s.walls)} walls, {len(s.objects)} objects in {len(cats)} categories")
+        print("  rooms: " + ", ".join(f"{r.id}={r.label}" for r in s.rooms))
+        if multi:
+            print("  several instances: " + ", ".join(f"{c} x{n}" for c, n in sorted(multi.items(), key=lambda kv: -kv[1])))
+        print("  categories: " + ", ".join(f"{c}({n})" for c, n in cats.items()))
+    return 0
+
+
+def cmd_render(args) -> int:
+    """Top-down map and first-person 8-view panorama of a scene."""
+    import math
+
+    import numpy as np
+
+    from ignjax.scenes.compile import compile_scene
+    from ignjax.scenes.io.sources import load_scenes
+    from ignjax.scenes.viz.mapplot import plot_scene_map
+    from ignjax.scenes.navgrid import GridConfig, build_navgrid
+    from ignjax.scenes.viz.render import VIEW_NAMES, ViewRenderer, save_png
+
+    scenes = load_scenes(args.path)
+    if args.scene:
+        scenes = [s for s in scenes if s.id == args.scene]
+        if not scenes:
+            raise SceneError(args.path, "--scene", f"no scene {args.scene!r} in the source")
+    scene = scenes[0]
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    compiled = compile_scene(scene)
+    if args.pose:
+        x, y, yaw = (float(v) for v in args.pose.split(","))
+    else:  # the navigable cell farthest from obstacles in the first room, facing its centroid
+        grid = build_navgrid(compiled, GridConfig())
+        room0 = grid.room_index(scene.rooms[0].id)
+        clear = np.where(grid.navigable & (grid.room == room0), grid.clearance, -1)
+        r, c = np.unravel_index(int(np.argmax(clear)), clear.shape)
+        x, y = grid.cell_to_world(np.array([r, c]))
+        cx, cy = scene.rooms[0].centroid
+        yaw = math.atan2(cy - y, cx - x) if (cx - x) ** 2 + (cy - y) ** 2 > 0.25 else 0.0
+    plot_scene_map(scene, out / f"{scene.id}_map.png")
+    with ViewRenderer(compiled.model, compiled.data, args.size, args.size, 90.0) as r:
+        views = r.panorama((x, y, 1.25), yaw, -0.2)
+    save_png(views[0], out / f"{scene.id}_front.png")
+    # 3 x 3 panel in the paper's layout: front-left, front, front-right / left, -, right / rear-left, rear, rear-right
+    layout = [[1, 0, 7], [2, None, 6], [3, 4, 5]]
+    tile = np.full((args.size, args.size, 3), 255, np.uint8)
+    panel = np.concatenate([np.concatenate([views[k] if k is not None else tile for k in row], 1) for row in layout], 0)
+    save_png(panel, out / f"{scene.id}_panorama.png")
+    print(f"wrote {out / (scene.id + '_map.png')}, {out / (scene.id + '_front.png')} and "
+          f"{out / (scene.id + '_panorama.png')} (eye at x={x:.2f}, y={y:.2f}, yaw={yaw:.2f}; views {', '.join(VIEW_NAMES)})")
+    return 0
+
+
+def cmd_episodes(args) -> int:
+    from ignjax.build.episodes import run_episodes_command
+
+    return run_episodes_command(args)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python -m ignjax.build", description=__doc__.split("\n\n")[0])
+    sub = p.add_subparsers(dest="command", required=True)
+
+    s = sub.add_parser("scenes", help="generate procedural houses as USD plus manifest.json")
+    s.add_argument("--out", required=True, help="output folder (created if missing)")
+    s.add_argument("--count", type=int, default=12, help="number of houses (default 12)")
+    s.add_argument("--seed", type=int, default=0, help="seed; the same seed gives the same files (default 0)")
+    s.add_argument("--min-rooms", type=int, default=2, help="fewest rooms per house (default 2)")
+    s.add_argument("--max-rooms", type=int, default=12, help="most rooms per house (default 12)")
+    s.add_argument("--maps", action="store_true", help="also write a top-down map PNG per house into OUT/maps/")
+    s.add_argument("--no-check", dest="check", action="store_false",
+                   help="skip compiling each house and checking that every room is reachable")
+    s.add_argument("--quiet", action="store_true", help="no progress bar")
+    s.set_defaults(func=cmd_scenes)
+
+    i = sub.add_parser("inspect", help="summarise a scene source (USD, ProcTHOR JSON/JSONL, glTF/GLB/OBJ, scene folder)")
+    i.add_argument("path")
+    i.add_argument("--json", action="store_true", help="print exactly one JSON object on stdout")
+    i.set_defaults(func=cmd_inspect)
+
+    r = sub.add_parser("render", help="draw a scene's top-down map and render a first-person 8-view panorama")
+    r.add_argument("path", help="a scene source (USD, ProcTHOR JSON, glTF/GLB/OBJ, scene folder)")
+    r.add_argument("--scene", help="scene id, when the source holds several (default: the first)")
+    r.add_argument("--out", default=".", help="output folder (default: current folder)")
+    r.add_argument("--pose", help="eye pose x,y,yaw (metres, radians); default: an open spot of the first room")
+    r.add_argument("--size", type=int, default=320, help="pixels per view (default 320)")
+    r.set_defaults(func=cmd_render)
+
+    e = sub.add_parser("episodes", help="build a benchmark from scenes, or --check an episode file")
+    e.add_argument("--scenes", nargs="+", help="scene sources: the scenes/ folder, USD files, ProcTHOR JSON/JSONL, glTF")
+    e.add_argument("--out", help="episode file to write (.jsonl or .jsonl.gz)")
+    e.add_argument("--subset", type=int, default=500, help="size of the balanced evaluation subset (default 500; 0 = all)")
+    e.add_argument("--seed", type=int, default=0, help="seed of every random choice (default 0)")
+    e.add_argument("--alpha", default="0.35,0.25,0.15,0.25", help="difficulty coefficients a1,a2,a3,a4 (sum 1)")
+    e.add_argument("--thresholds", default="0.30,0.60", help="easy/medium and medium/hard thresholds")
+    e.add_argument("--normalize-alpha", action="store_true", help="rescale --alpha to sum 1 instead of rejecting it")
+    e.add_argument("--starts", type=int, default=3, help="start poses sampled per candidate target (default 3)")
+    e.add_argument("--check", metavar="FILE", help="validate an episode file (against its scenes too) and print its counts")
+    e.add_argument("--schema-only", action="store_true", help="with --check: validate the records only, not against the scenes")
+    e.add_argument("--figure", help="where to draw the statistics figure (default: next to --out)")
+    e.add_argument("--quiet", action="store_true", help="no progress bar")
+    e.set_defaults(func=cmd_episodes)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except IgnjaxError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,198 @@
+"""Episode files -> the array batch the simulator consumes.
+
+:func:`load_benchmark` reads a released episode file, finds and loads the
+scenes its records name (``scene_file`` is resolved against the episode
+file's folder, then against ``scenes_root`` when given), builds a
+:class:`~ignjax.scenes.bank.SceneBank` of exactly those scenes, validates
+every record against the scenes, computes one geodesic field per distinct
+target and returns an :class:`EpisodeSet`: the records, the bank, the
+fields and the batched :class:`~ignjax.sim.types.EpisodeSpec`.
+
+Validation (each error names the file, the line/episode and the field):
+unknown scene id or unreadable scene file; a target id not in the scene;
+a target category that differs from the scene's; a start pose outside the
+scene's navigable area or in a different navigable component than the
+target (unreachable); plus every schema check of
+:func:`ignjax.episodes.schema.read_episodes`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from ignjax.episodes.difficulty import BIN_INDEX
+from ignjax.episodes.schema import read_episodes
+from ignjax.errors import EpisodeError, IgnjaxError
+from ignjax.scenes import vocab
+from ignjax.scenes.bank import SceneBank, target_fields
+from ignjax.scenes.io.sources import load_scenes
+from ignjax.scenes.navgrid import GridConfig
+from ignjax.sim.types import EpisodeSpec
+
+
+@dataclass(eq=False)
+class EpisodeSet:
+    """A benchmark ready to run.
+
+    Attributes:
+        path: the episode file.
+        records: the released records, in file order.
+        bank: scene bank of the scenes the records use.
+        fields: (F, H, W) float32 geodesic fields of the distinct targets.
+        specs: :class:`EpisodeSpec` with a leading axis of len(records).
+        field_index: (E,) int32 field of each episode.
+    """
+
+    path: Path
+    records: list[dict]
+    bank: SceneBank
+    fields: jax.Array
+    specs: EpisodeSpec
+    field_index: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.records)
+
+    @property
+    def episode_ids(self) -> list[str]:
+        return [r["episode_id"] for r in self.records]
+
+    def subset(self, indices) -> "EpisodeSet":
+        """The same benchmark restricted to some episodes (shares bank and fields)."""
+        idx = np.asarray(indices, np.int64)
+        specs = jax.tree.map(lambda a: a[idx], self.specs)
+        return dataclasses.replace(self, records=[self.records[i] for i in idx], specs=specs,
+                                   field_index=self.field_index[idx])
+
+
+def _resolve_scene_file(name: str, episode_file: Path, scenes_root: Path | None) -> Path:
+    p = Path(name)
+    candidates = [p] if p.is_absolute() else [episode_file.parent / p] + ([scenes_root / p, scenes_root / p.name] if scenes_root else [])
+    for c in candidates:
+        if c.exists():
+            return c
+    return candidates[0]
+
+
+def _cat(bank: SceneBank, name) -> int:
+    return bank.category_index(name) if name else -1
+
+
+def episode_specs(records: list[dict], bank: SceneBank, path: str | os.PathLike | None = None) -> tuple[EpisodeSpec, list[tuple[int, int]], np.ndarray]:
+    """Validate records against the bank and build their specs.
+
+    Returns:
+        (specs with leading axis E, distinct (scene, target) pairs in field
+        order, (E,) field index of each episode).
+
+    Raises:
+        EpisodeError: naming the file, the episode and the field.
+    """
+    pairs: dict[tuple[int, int], int] = {}
+    rows = []
+    for k, rec in enumerate(records):
+        where = f"episode {rec['episode_id']}"
+        try:
+            s = bank.scene_index(rec["scene_id"])
+        except KeyError:
+            raise EpisodeError(path, f"{where}: scene_id", f"scene {rec['scene_id']!r} is not among the loaded scenes {list(bank.scene_ids)}") from None
+        try:
+            t = bank.instance_index(s, rec["target_id"])
+        except KeyError:
+            raise EpisodeError(path, f"{where}: target_id", f"instance {rec['target_id']!r} is not in scene {rec['scene_id']!r}") from None
+        scene = bank.scene(s)
+        target = scene.instances[t]
+        if target.category != rec["target_category"]:
+            raise EpisodeError(path, f"{where}: target_category", f"{rec['target_category']!r} but instance {target.id!r} is a {target.category!r}")
+        grid = bank.navgrids[s]
+        x, y = rec["start"]["x"], rec["start"]["y"]
+        r, c = grid.world_to_cell(np.array([x, y]))
+        if not (0 <= r < grid.shape[0] and 0 <= c < grid.shape[1]) or not grid.navigable[r, c]:
+            raise EpisodeError(path, f"{where}: start", f"start ({x:.3f}, {y:.3f}) is off the navigable area of scene {scene.id!r}")
+        goal = rec["goal_room"]["id"]
+        gi = grid.room_index(goal) if goal in grid.room_ids else -1
+        pairs.setdefault((s, t), len(pairs))
+        facts = rec["oracle"]["facts"]
+        attrs = [vocab.COLOR_INDEX.get(facts.get("color"), -1), vocab.MATERIAL_INDEX.get(facts.get("material"), -1),
+                 vocab.SIZE_INDEX.get(facts.get("size"), -1), vocab.STATE_INDEX.get(facts.get("state"), -1)]
+        near = [_cat(bank, c_) for c_ in (facts.get("near") or [])][:3]
+        near += [-1] * (3 - len(near))
+        rows.append(dict(scene=s, target=t, field=pairs[(s, t)], category=_cat(bank, target.category),
+                         start=[x, y, rec["start"]["yaw"]], difficulty=BIN_INDEX[rec["difficulty"]], goal_room=gi,
+                         fact_attrs=attrs, fact_on=_cat(bank, facts.get("on")), fact_near=near,
+                         region_category=_cat(bank, rec["oracle"].get("region_anchor")), valid=True))
+    specs = EpisodeSpec(
+        scene=jnp.asarray([r["scene"] for r in rows], jnp.int32), target=jnp.asarray([r["target"] for r in rows], jnp.int32),
+        field=jnp.asarray([r["field"] for r in rows], jnp.int32), category=jnp.asarray([r["category"] for r in rows], jnp.int32),
+        start=jnp.asarray([r["start"] for r in rows], jnp.float32), difficulty=jnp.asarray([r["difficulty"] for r in rows], jnp.int32),
+        goal_room=jnp.asarray([r["goal_room"] for r in rows], jnp.int32),
+        fact_attrs=jnp.asarray([r["fact_attrs"] for r in rows], jnp.int32), fact_on=jnp.asarray([r["fact_on"] for r in rows], jnp.int32),
+        fact_near=jnp.asarray([r["fact_near"] for r in rows], jnp.int32),
+        region_category=jnp.asarray([r["region_category"] for r in rows], jnp.int32),
+        valid=jnp.ones(len(rows), bool),
+    )
+    return specs, list(pairs), np.asarray([r["field"] for r in rows], np.int32)
+
+
+def load_benchmark(path: str | os.PathLike, scenes_root: str | os.PathLike | None = None,
+                   grid: GridConfig = GridConfig(), field_batch: int = 32, progress=None) -> EpisodeSet:
+    """Read, validate and prepare an episode file for simulation (see module doc)."""
+    p = Path(path)
+    records = read_episodes(p)
+    root = Path(scenes_root) if scenes_root else None
+    by_file: dict[Path, set[str]] = {}
+    first_line: dict[Path, str] = {}
+    first_use: dict[tuple[Path, str], str] = {}
+    for rec in records:
+        f = _resolve_scene_file(rec["scene_file"], p, root)
+        by_file.setdefault(f, set()).add(rec["scene_id"])
+        first_line.setdefault(f, rec["episode_id"])
+        first_use.setdefault((f, rec["scene_id"]), rec["episode_id"])
+    scenes = []
+    for f, ids in sorted(by_file.items(), key=lambda kv: str(kv[0])):
+        try:
+            loaded = {s.id: s for s in load_scenes(f)}
+        except IgnjaxError as e:
+            raise EpisodeError(p, f"episode {first_line[f]}: scene_file", f"cannot load scene file {str(f)!r}: {e}") from e
+        for sid in sorted(ids):
+            if sid not in loaded:
+                raise EpisodeError(p, f"episode {first_use[(f, sid)]}: scene_id",
+                                   f"scene {sid!r} not found in {str(f)!r} (it holds {sorted(loaded)})")
+            scenes.append(loaded[sid])
+    bank = SceneBank.build(scenes, grid, check=False)
+    specs, pairs, field_index = episode_specs(records, bank, p)
+    fields = compute_fields(bank, pairs, field_batch, progress)
+    # reachability: the start must see a finite geodesic distance to its target
+    fi = np.asarray(field_index)
+    starts = np.asarray(specs.start)
+    for k, rec in enumerate(records):
+        s = int(specs.scene[k])
+        grid_ = bank.navgrids[s]
+        r, c = grid_.world_to_cell(starts[k, :2])
+        if not np.isfinite(np.asarray(fields[fi[k], r, c])):
+            raise EpisodeError(p, f"episode {rec['episode_id']}: start", "the target cannot be reached from the start pose")
+    return EpisodeSet(p, records, bank, fields, specs, field_index)
+
+
+def compute_fields(bank: SceneBank, pairs: list[tuple[int, int]], batch: int = 32, progress=None) -> jax.Array:
+    """Geodesic fields (F, H, W) of (scene, instance) pairs, in batches."""
+    if not pairs:
+        H, W = bank.grid.navigable.shape[1:]
+        return jnp.zeros((0, H, W), jnp.float32)
+    fn = jax.jit(lambda s, i: target_fields(bank, s, i))
+    out = []
+    chunks = range(0, len(pairs), batch)
+    for start in (progress(chunks) if progress else chunks):
+        chunk = pairs[start:start + batch]
+        pad = batch - len(chunk)
+        s = np.array([a for a, _ in chunk] + [chunk[-1][0]] * pad, np.int32)
+        i = np.array([b for _, b in chunk] + [chunk[-1][1]] * pad, np.int32)
+        out.append(np.asarray(fn(s, i))[:len(chunk)])
+    return jnp.asarray(np.concatenate(out))

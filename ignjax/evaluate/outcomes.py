@@ -1,0 +1,200 @@
+"""Outcome tables: one row per (agent, episode), written as Parquet and CSV.
+
+Columns (both formats):
+
+==================  ==========================================================
+agent               agent name (plus a setting label in sweeps)
+episode_id          episode id (from the episode file)
+scene_id            scene
+difficulty          easy / medium / hard
+final_distance      geodesic distance to the target at the end, m
+final_euclidean     2-D distance to the target's footprint at the end, m
+min_distance        smallest geodesic distance along the path, m (for OSR)
+path_length         metres travelled
+steps               planner steps used
+stopped             ended with a STOP action
+stop_reason         running / stop / step_budget
+q1, q2, q3, q4      charged questions per type
+n_questions         their sum
+n_refused           questions refused (budget spent), not charged
+n_invalid           out-of-range actions clamped
+trace               question attempts as "type@step" (charged) or
+                    "type@step!" (refused), separated by spaces
+==================  ==========================================================
+
+Everything the metrics need is in these columns: :func:`metric_rows`
+recomputes SR, OSR, NE, TL, Q_t, |Q| and WSR from a table read back from
+either file (:func:`read_outcomes`), with any thresholds and costs.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ignjax.evaluate import metrics as M
+from ignjax.episodes.difficulty import BIN_INDEX, BIN_NAMES
+from ignjax.errors import InputError
+from ignjax.fileio import atomic_write
+from ignjax.sim.types import STOP_REASONS
+
+COLUMNS: tuple[str, ...] = (
+    "agent", "episode_id", "scene_id", "difficulty", "final_distance", "final_euclidean", "min_distance",
+    "path_length", "steps", "stopped", "stop_reason", "q1", "q2", "q3", "q4", "n_questions", "n_refused", "n_invalid",
+    "trace",
+)
+
+
+def _trace(types, steps, charged) -> str:
+    parts = [f"{int(t)}@{int(s)}" + ("" if c else "!") for t, s, c in zip(types, steps, charged) if t > 0]
+    return " ".join(parts)
+
+
+def parse_trace(text: str) -> list[tuple[int, int, bool]]:
+    """``"1@0 3@4 4@9!"`` -> [(1, 0, True), (3, 4, True), (4, 9, False)]."""
+    out = []
+    for part in str(text or "").split():
+        charged = not part.endswith("!")
+        t, s = part.rstrip("!").split("@")
+        out.append((int(t), int(s), charged))
+    return out
+
+
+def outcome_rows(agent: str, records: list[dict], out) -> list[dict]:
+    """Rows of an outcome table from a rollout's :class:`~ignjax.sim.env.OutcomeRow`
+    (numpy or JAX arrays with leading axis E matching ``records``)."""
+    o = {k: np.asarray(getattr(out, k)) for k in ("final_distance", "final_euclidean", "min_distance", "path_length",
+                                                  "steps", "stopped", "stop_reason", "n_questions", "n_refused",
+                                                  "n_invalid", "trace_type", "trace_step", "trace_charged")}
+    rows = []
+    for k, rec in enumerate(records):
+        q = o["n_questions"][k]
+        rows.append({
+            "agent": agent, "episode_id": rec["episode_id"], "scene_id": rec["scene_id"], "difficulty": rec["difficulty"],
+            "final_distance": float(o["final_distance"][k]), "final_euclidean": float(o["final_euclidean"][k]),
+            "min_distance": float(o["min_distance"][k]), "path_length": float(o["path_length"][k]),
+            "steps": int(o["steps"][k]), "stopped": bool(o["stopped"][k]),
+            "stop_reason": STOP_REASONS[int(o["stop_reason"][k])], "q1": int(q[0]), "q2": int(q[1]), "q3": int(q[2]),
+            "q4": int(q[3]), "n_questions": int(q.sum()), "n_refused": int(o["n_refused"][k]),
+            "n_invalid": int(o["n_invalid"][k]),
+            "trace": _trace(o["trace_type"][k], o["trace_step"][k], o["trace_charged"][k]),
+        })
+    return rows
+
+
+def _arrow_table(rows: list[dict]):
+    import pyarrow as pa
+
+    schema = pa.schema([("agent", pa.string()), ("episode_id", pa.string()), ("scene_id", pa.string()),
+                        ("difficulty", pa.string()), ("final_distance", pa.float64()), ("final_euclidean", pa.float64()),
+                        ("min_distance", pa.float64()), ("path_length", pa.float64()), ("steps", pa.int32()),
+                        ("stopped", pa.bool_()), ("stop_reason", pa.string()), ("q1", pa.int32()), ("q2", pa.int32()),
+                        ("q3", pa.int32()), ("q4", pa.int32()), ("n_questions", pa.int32()), ("n_refused", pa.int32()),
+                        ("n_invalid", pa.int32()), ("trace", pa.string())])
+    return pa.Table.from_pylist(rows, schema=schema)
+
+
+def write_outcomes(rows: list[dict], folder: str | os.PathLike, name: str = "outcomes") -> tuple[Path, Path]:
+    """Write ``name.parquet`` and ``name.csv`` atomically. Returns both paths."""
+    import pyarrow.parquet as pq
+
+    folder = Path(folder)
+    table = _arrow_table(rows)
+    buf = io.BytesIO()
+    pq.write_table(table, buf)
+    p_parquet = folder / f"{name}.parquet"
+    atomic_write(p_parquet, buf.getvalue())
+    text = io.StringIO()
+    w = csv.DictWriter(text, fieldnames=list(COLUMNS), lineterminator="\n")
+    w.writeheader()
+    for r in rows:
+        w.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in r.items()})
+    p_csv = folder / f"{name}.csv"
+    atomic_write(p_csv, text.getvalue().encode())
+    return p_parquet, p_csv
+
+
+def read_outcomes(path: str | os.PathLike) -> list[dict]:
+    """Rows of an outcome table from Parquet or CSV (types restored).
+
+    Raises:
+        InputError: missing file, unknown format, or missing columns.
+    """
+    p = Path(path)
+    if not p.exists():
+        raise InputError(p, None, "no such file")
+    if p.suffix == ".parquet":
+        import pyarrow.parquet as pq
+
+        rows = pq.read_table(p).to_pylist()
+    elif p.suffix == ".csv":
+        with open(p, newline="") as f:
+            rows = list(csv.DictReader(f))
+        floats = ("final_distance", "final_euclidean", "min_distance", "path_length")
+        ints = ("steps", "q1", "q2", "q3", "q4", "n_questions", "n_refused", "n_invalid")
+        for i, r in enumerate(rows):
+            try:
+                for k in floats:
+                    r[k] = float(r[k])
+                for k in ints:
+                    r[k] = int(r[k])
+                r["stopped"] = r["stopped"] in ("True", "true", "1")
+            except (KeyError, ValueError) as e:
+                raise InputError(p, f"line {i + 2}", f"bad or missing value: {e}") from e
+    else:
+        raise InputError(p, None, "expected a .parquet or .csv outcome table")
+    if rows:
+        missing = [c for c in COLUMNS if c not in rows[0]]
+        if missing:
+            raise InputError(p, "columns", f"missing {missing}")
+    return rows
+
+
+def to_metric_outcomes(rows: list[dict], distance: str = "geodesic") -> M.Outcomes:
+    """Arrays for :func:`ignjax.evaluate.metrics.summarize` from table rows.
+
+    Args:
+        distance: ``"geodesic"`` (default) or ``"euclidean"`` final distance
+            for success; OSR always uses the geodesic minimum along the path.
+    """
+    key = {"geodesic": "final_distance", "euclidean": "final_euclidean"}[distance]
+    return M.Outcomes.from_numpy(
+        final_distance=np.array([r[key] for r in rows], float),
+        min_distance=np.array([r["min_distance"] for r in rows], float),
+        path_length=np.array([r["path_length"] for r in rows], float),
+        stopped=np.array([r["stopped"] for r in rows], bool),
+        n_questions=np.array([[r["q1"], r["q2"], r["q3"], r["q4"]] for r in rows], np.int64),
+        difficulty=np.array([BIN_INDEX[r["difficulty"]] for r in rows], np.int64),
+    )
+
+
+def metric_rows(rows: list[dict], thresholds=M.DEFAULT_THRESHOLDS, costs=M.LOCKED_COSTS, require_stop: bool = True,
+                distance: str = "geodesic") -> dict[str, dict]:
+    """Agent -> :func:`ignjax.evaluate.metrics.metric_row`, recomputed from table rows."""
+    agents: dict[str, list[dict]] = {}
+    for r in rows:
+        agents.setdefault(r["agent"], []).append(r)
+    return {a: M.metric_row(to_metric_outcomes(rs, distance), thresholds, costs, require_stop) for a, rs in agents.items()}
+
+
+def write_metric_table(metrics: dict[str, dict], path: str | os.PathLike) -> Path:
+    """One CSV row per agent with every metric (overall and per difficulty)."""
+    p = Path(path)
+    keys: list[str] = []
+    for m in metrics.values():
+        keys += [k for k in m if k not in keys]
+    text = io.StringIO()
+    w = csv.DictWriter(text, fieldnames=["agent"] + keys, lineterminator="\n")
+    w.writeheader()
+    for agent, m in metrics.items():
+        w.writerow({"agent": agent, **{k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in m.items()}})
+    atomic_write(p, text.getvalue().encode())
+    return p
+
+
+__all__ = ["COLUMNS", "BIN_NAMES", "outcome_rows", "write_outcomes", "read_outcomes", "to_metric_outcomes", "metric_rows",
+           "write_metric_table", "parse_trace"]

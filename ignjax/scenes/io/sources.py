@@ -1,0 +1,130 @@
+"""Read any supported scene source: one entry point, dispatch by file type.
+
+=====================================  =========================================
+source                                 reader
+=====================================  =========================================
+directory with ``manifest.json``       every scene the manifest lists
+directory without a manifest           every supported file in it (sorted)
+``.usd`` ``.usda`` ``.usdc`` ``.usdz``   :func:`ignjax.scenes.io.usd.load_usd`
+``.json`` (ignjax scene document)      :func:`ignjax.scenes.model.scene_from_dict`
+``.json`` (ProcTHOR house)             :func:`ignjax.scenes.io.procthor.load_procthor`
+``.jsonl`` ``.jsonl.gz``               one ProcTHOR house per line
+``.gltf`` ``.glb`` ``.obj``            :func:`ignjax.scenes.io.meshes.load_mesh_scene`
+=====================================  =========================================
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+from ignjax.errors import SceneError
+from ignjax.scenes.io.manifest import read_manifest
+from ignjax.scenes.model import Scene, scene_from_dict
+
+USD_SUFFIXES = (".usd", ".usda", ".usdc", ".usdz")
+MESH_SUFFIXES = (".gltf", ".glb", ".obj")
+JSON_SUFFIXES = (".json", ".jsonl", ".jsonl.gz", ".json.gz")
+SIDECAR_SUFFIX = ".ignjax.json"
+"""Mesh-scene sidecars (see :mod:`ignjax.scenes.io.meshes`); never scenes themselves."""
+
+
+def _suffix(path: Path) -> str:
+    name = path.name.lower()
+    for s in (".jsonl.gz", ".json.gz"):
+        if name.endswith(s):
+            return s
+    return path.suffix.lower()
+
+
+def is_scene_file(path: str | os.PathLike) -> bool:
+    """True when ``path`` has a suffix this module can read."""
+    return _suffix(Path(path)) in USD_SUFFIXES + MESH_SUFFIXES + JSON_SUFFIXES
+
+
+def load_scenes(path: str | os.PathLike) -> list[Scene]:
+    """Read every scene in ``path`` (a file or a folder).
+
+    Raises:
+        SceneError: the path does not exist, is of an unsupported type, or
+            its content is invalid (the message names file, place and reason).
+    """
+    p = Path(path)
+    if not p.exists():
+        raise SceneError(p, None, "no such file or directory")
+    if p.is_dir():
+        manifest = p / "manifest.json"
+        if manifest.exists():
+            from ignjax.scenes.io.manifest import read_manifest
+
+            return [s for entry in read_manifest(manifest) for s in load_scenes(p / entry["file"])]
+        files = sorted(f for f in p.iterdir() if f.is_file() and is_scene_file(f) and not f.name.endswith(SIDECAR_SUFFIX))
+        if not files:
+            raise SceneError(p, None, "the directory holds no USD, JSON or mesh scene files")
+        return [s for f in files for s in load_scenes(f)]
+    suffix = _suffix(p)
+    if suffix in USD_SUFFIXES:
+        from ignjax.scenes.io.usd import load_usd
+
+        return [load_usd(p)]
+    if suffix in MESH_SUFFIXES:
+        from ignjax.scenes.io.meshes import load_mesh_scene
+
+        return [load_mesh_scene(p)]
+    if suffix in (".jsonl", ".jsonl.gz"):
+        from ignjax.scenes.io.procthor import load_procthor
+
+        return load_procthor(p)
+    if suffix in (".json", ".json.gz"):
+        doc = _read_json(p)
+        if isinstance(doc, dict) and doc.get("format") == "ignjax-scene":
+            return [scene_from_dict(doc, str(p))]
+        from ignjax.scenes.io.procthor import load_procthor
+
+        return load_procthor(p)
+    raise SceneError(p, None, f"unsupported file type {suffix or '(none)'!r}: expected USD (.usd/.usda/.usdc/.usdz), "
+                               "JSON (.json/.jsonl/.jsonl.gz: ProcTHOR houses or ignjax scenes) or a mesh (.gltf/.glb/.obj)")
+
+
+def load_scene(path: str | os.PathLike) -> Scene:
+    """Read exactly one scene; error when the source holds several."""
+    scenes = load_scenes(path)
+    if len(scenes) != 1:
+        raise SceneError(path, None, f"expected one scene, found {len(scenes)}")
+    return scenes[0]
+
+
+def _read_json(p: Path):
+    import gzip
+
+    opener = gzip.open if p.name.lower().endswith(".gz") else open
+    try:
+        with opener(p, "rt", encoding="utf-8") as f:
+            return json.load(f)
+    except UnicodeDecodeError as e:
+        raise SceneError(p, None, f"not a text JSON file ({e.reason})") from e
+    except json.JSONDecodeError as e:
+        raise SceneError(p, f"line {e.lineno}, column {e.colno}", f"invalid JSON: {e.msg}") from e
+    except OSError as e:
+        raise SceneError(p, None, f"cannot read: {e}") from e
+
+
+def scene_sources(paths) -> list[tuple[object, Path]]:
+    """(scene, file) pairs for every scene in the given sources."""
+    out = []
+    for raw in paths:
+        p = Path(raw)
+        if not p.exists():
+            raise SceneError(p, None, "no such file or directory")
+        if p.is_dir():
+            manifest = p / "manifest.json"
+            files = [p / e["file"] for e in read_manifest(manifest)] if manifest.exists() else sorted(
+                f for f in p.iterdir() if f.is_file() and is_scene_file(f) and not f.name.endswith(SIDECAR_SUFFIX))
+            if not files:
+                raise SceneError(p, None, "the directory holds no scene files")
+        else:
+            files = [p]
+        for f in files:
+            out += [(s, f) for s in load_scenes(f)]
+    return out

@@ -1,0 +1,7 @@
+"""``python -m ignjax.sweep``."""
+
+import sys
+
+from ignjax.sweep.runner import main
+
+sys.exit(main())

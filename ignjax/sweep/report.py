@@ -1,0 +1,395 @@
+"""Studies' tables, figures and ``report.md`` of a sweep run (:mod:`ignjax.sweep.runner`).
+
+Everything here is a deterministic function of the rollouts and the
+configuration, so an interrupted-and-resumed run writes the same bytes as
+an uninterrupted one. Each ``study_*`` function is also usable on its own
+from Python (see the notebooks).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+
+from ignjax.evaluate import metrics as M
+from ignjax.episodes.difficulty import BIN_INDEX, BIN_NAMES
+from ignjax.fileio import atomic_write
+
+FACTOR_NAMES = ("F_distractor", "F_room", "F_context", "F_start")
+
+
+def _fmt(v) -> str:
+    if isinstance(v, (float, np.floating)):
+        return "nan" if not math.isfinite(float(v)) else f"{float(v):.6g}"
+    return str(v)
+
+
+def write_csv(path: Path, header: list[str], rows: list[list]) -> Path:
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(header)
+    for r in rows:
+        w.writerow([_fmt(v) for v in r])
+    return atomic_write(path, buf.getvalue())
+
+
+def md_table(header: list[str], rows: list[list]) -> str:
+    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
+    def cell(v):
+        if isinstance(v, str):
+            return v
+        if isinstance(v, (float, np.floating)):
+            return "nan" if not math.isfinite(float(v)) else f"{float(v):.4g}"
+        return str(v)
+
+    lines += ["| " + " | ".join(cell(v) for v in r) + " |" for r in rows]
+    return "\n".join(lines)
+
+
+# ---------------------------------------------------------------------------
+# inputs from rollouts
+# ---------------------------------------------------------------------------
+
+
+def agent_arrays(es, rollouts: dict, cfg: dict) -> dict:
+    """Stacked per-agent arrays: success (A, E, T), n_questions (A, E, 4), valid, difficulty."""
+    names = list(rollouts)
+    outs = [rollouts[a]["out"] for a in names]
+    fd = np.stack([np.asarray(o["final_distance"]) for o in outs])
+    stopped = np.stack([np.asarray(o["stopped"]) for o in outs])
+    success = np.asarray(M.episode_success(fd, stopped, tuple(cfg["eval"]["thresholds"]), cfg["eval"]["require_stop"]))
+    nq = np.stack([np.asarray(o["n_questions"]) for o in outs]).astype(np.int64)
+    difficulty = np.array([BIN_INDEX[r["difficulty"]] for r in es.records], np.int64)
+    return {"names": names, "success": success, "n_questions": nq, "valid": np.ones(fd.shape, bool),
+            "difficulty": difficulty}
+
+
+def factors_of(es) -> np.ndarray:
+    return np.array([[r["factors"][k] for k in FACTOR_NAMES] for r in es.records], np.float64)
+
+
+# ---------------------------------------------------------------------------
+# studies
+# ---------------------------------------------------------------------------
+
+
+def study_eval(es, rollouts: dict, cfg: dict, out: Path) -> dict:
+    from ignjax.evaluate.outcomes import metric_rows, outcome_rows, write_metric_table, write_outcomes
+
+    rows = []
+    for name, tree in rollouts.items():
+        if name not in cfg["eval"]["agents"]:
+            continue
+        rows += outcome_rows(name, es.records, SimpleNamespace(**tree["out"]))
+    write_outcomes(rows, out)
+    metrics = metric_rows(rows, tuple(cfg["eval"]["thresholds"]), tuple(cfg["eval"]["costs"]), cfg["eval"]["require_stop"])
+    write_metric_table(metrics, out / "metrics.csv")
+    return {"rows": rows, "metrics": metrics}
+
+
+def study_costs(es, rollouts: dict, in_loop: dict | None, cfg: dict, out: Path) -> dict:
+    from ignjax.studies import cost_sensitivity as CS
+    from ignjax.sweep.runner import in_loop_costs
+
+    arr = agent_arrays(es, {a: rollouts[a] for a in cfg["eval"]["agents"]}, cfg)
+    locked = np.asarray(cfg["eval"]["costs"], np.float64)
+    total = float(locked.sum())
+    include = np.stack([locked, np.full(4, total / 4)])
+    costs = CS.cost_samples(int(cfg["costs"]["samples"]), int(cfg["costs"]["seed"]), total=total, include=include)
+    ti = cfg["eval"]["thresholds"].index(1.5) if 1.5 in cfg["eval"]["thresholds"] else None
+    res = CS.run_study(arr["success"], arr["n_questions"], arr["valid"], costs, agent_names=arr["names"],
+                       threshold_index=ti)
+    fig = out / "figures"
+    CS.plot_marginal_wsr(res, fig / "costs_marginal_wsr.png")
+    CS.plot_flip_map(res, fig / "costs_flip_map.png")
+    ranked = res["wsr_ranked"]
+    rows = []
+    for a, name in enumerate(res["agent_names"]):
+        rows.append([name, ranked[0, a], ranked[1, a], float(np.mean(ranked[:, a])), float(np.min(ranked[:, a])),
+                     float(np.max(ranked[:, a])), int(res["reference_ranks"][a]), float(np.mean(res["ranks"][:, a]))])
+    header = ["agent", "WSR locked", "WSR uniform", "WSR mean", "WSR min", "WSR max", "rank locked", "mean rank"]
+    write_csv(out / "costs_offline.csv", header, rows)
+    summary = {"offline": res, "offline_table": (header, rows)}
+    if in_loop is not None:
+        vecs, labels = in_loop_costs(cfg)
+        o = in_loop["out"]
+        fd, stopped = np.asarray(o["final_distance"]), np.asarray(o["stopped"])  # (K, E)
+        nq = np.asarray(o["n_questions"]).astype(np.float64)  # (K, E, 4)
+        thr = 1.5 if 1.5 in cfg["eval"]["thresholds"] else cfg["eval"]["thresholds"][0]
+        succ = np.asarray(M.episode_success(fd, stopped, (thr,), cfg["eval"]["require_stop"]))[..., 0]
+        disc = np.exp(-np.einsum("ket,kt->ke", nq, vecs))
+        lrows = []
+        for k, lab in enumerate(labels):
+            lrows.append([lab] + [float(c) for c in vecs[k]] + [float(nq[k].sum(-1).mean())]
+                         + [float(nq[k, :, t].mean()) for t in range(4)]
+                         + [100 * float(succ[k].mean()), 100 * float((succ[k] * disc[k]).mean())])
+        lheader = ["setting", "w1", "w2", "w3", "w4", "|Q|", "Q1", "Q2", "Q3", "Q4", f"SR@{thr:g}", f"WSR@{thr:g}"]
+        write_csv(out / "costs_in_loop.csv", lheader, lrows)
+        _plot_in_loop(cfg, vecs, labels, nq, succ, disc, fig / "costs_in_loop.png")
+        summary["in_loop_table"] = (lheader, lrows)
+        summary["in_loop_agent"] = cfg["costs"]["agent"]
+    return summary
+
+
+def _plot_in_loop(cfg, vecs, labels, nq, succ, disc, path):
+    from ignjax.studies._common import new_figure, save
+
+    n_s = len(cfg["costs"]["scales"])
+    scales = np.asarray(cfg["costs"]["scales"])
+    fig, axs = new_figure(1, 2, size=(11.0, 4.0))
+    ax = axs[0, 0]
+    for t in range(4):
+        ax.plot(scales, nq[:n_s, :, t].mean(-1), marker="o", label=f"Type {t + 1}")
+    ax.plot(scales, nq[:n_s].sum(-1).mean(-1), marker="s", color="k", label="all types (|Q|)")
+    ax.set_xscale("log")
+    ax.set_xlabel("cost scale (x locked costs)")
+    ax.set_ylabel("questions per episode")
+    ax.set_title(f"{cfg['costs']['agent']}: asking vs charged costs")
+    ax.legend(fontsize=8)
+    ax = axs[0, 1]
+    ax.plot(scales, 100 * succ[:n_s].mean(-1), marker="o", label="SR@1.5")
+    ax.plot(scales, 100 * (succ[:n_s] * disc[:n_s]).mean(-1), marker="s", label="WSR@1.5 (charged costs)")
+    ax.set_xscale("log")
+    ax.set_xlabel("cost scale (x locked costs)")
+    ax.set_ylabel("rate (%)")
+    ax.set_title("success under the charged costs")
+    ax.legend(fontsize=8)
+    save(fig, path)
+
+
+def study_difficulty(es, rollouts: dict, cfg: dict, out: Path) -> dict:
+    from ignjax.studies import difficulty_ablation as DA
+
+    arr = agent_arrays(es, {a: rollouts[a] for a in cfg["eval"]["agents"]}, cfg)
+    ti = cfg["eval"]["thresholds"].index(1.5) if 1.5 in cfg["eval"]["thresholds"] else 0
+    success = arr["success"][..., ti]
+    factors = factors_of(es)
+    alphas = DA.alpha_grid(cfg["difficulty"]["alpha_step"])
+    thresholds = DA.threshold_grid(cfg["difficulty"]["threshold_step"])
+    # the reference setting (difficulty.alpha / thresholds) is added to the grids so it is always evaluated
+    d_alpha = np.asarray(cfg["difficulty"]["alpha"], np.float64)
+    d_thr = np.asarray(cfg["difficulty"]["thresholds"], np.float64)
+    alphas = np.concatenate([d_alpha[None], alphas])
+    thresholds = np.concatenate([d_thr[None], thresholds])
+    abl = DA.ablate(factors, success, None, alphas, thresholds, empty=cfg["difficulty"]["empty"])
+    gi, hi = 0, 0
+    cal = DA.calibrate(factors, 1.0 - success, None, alphas[1:], cfg["difficulty"]["split_seed"])
+    fig = out / "figures"
+    DA.plot_ordering(abl, fig / "difficulty_ordering.png")
+    DA.plot_calibration(cal, fig / "difficulty_calibration.png")
+    rows = [[name] + [100 * float(abl["sr"][gi, hi, a, b]) for b in range(3)] for a, name in enumerate(arr["names"])]
+    header = ["agent", "SR@1.5 easy", "SR@1.5 medium", "SR@1.5 hard"]
+    write_csv(out / "difficulty_default_bins.csv", header, rows)
+    crow = [["fitted"] + [float(x) for x in cal["alpha"]] + [cal["fit_corr"], cal["holdout_corr"]],
+            ["default (0.35, 0.25, 0.15, 0.25)"] + [float(x) for x in cal["default_alpha"]] + [cal["default_fit_corr"], cal["default_holdout_corr"]]]
+    cheader = ["alpha", *FACTOR_NAMES, "spearman fit half", "spearman holdout half"]
+    write_csv(out / "difficulty_calibration.csv", cheader, crow)
+    return {"ablation": abl, "calibration": cal, "default_bins": (header, rows), "calibration_table": (cheader, crow),
+            "default_proportions": abl["proportions"][gi, hi], "n_settings": int(abl["ordered"].size)}
+
+
+def study_derive_costs(cfg: dict, out: Path) -> dict:
+    from ignjax.studies import cost_derivation as C
+
+    dc = cfg["derive-costs"]
+    if dc["annotations"]:
+        stats = C.statistics_from_annotations(dc["annotations"])
+        source = f"annotations {dc['annotations']}"
+    else:
+        stats = C.published_statistics(dc["assumption"])
+        source = f"published statistics (assumption: {dc['assumption']})"
+    locked = tuple(cfg["eval"]["costs"])
+    derived = C.derive_costs(stats, tuple(dc["lambdas"]), locked=locked)
+    fitted = C.fit_lambdas(stats, locked=locked) if dc["fit"] else None
+    header = ["setting", "lambda_s", "lambda_h", "lambda_r", "w1", "w2", "w3", "w4", "ordering", "rmse to locked"]
+    rows = [["locked", "", "", ""] + list(locked) + ["".join(str(t) for t in C._ordering(locked)), 0.0]]
+    for name, d in (("given lambdas", derived), ("fitted lambdas", fitted)):
+        if d is not None:
+            rows.append([name, *d.lambdas, *map(float, d.costs), "".join(str(t) for t in d.ordering), d.rmse])
+    write_csv(out / "derive_costs.csv", header, rows)
+    return {"source": source, "table": (header, rows), "assumed": list(getattr(stats, "assumed", []) or [])}
+
+
+def study_analysis(es, rollouts: dict, cfg: dict, out: Path) -> dict:
+    from ignjax.studies import interaction as IA
+
+    agent = cfg["analysis"]["agent"]
+    tree = rollouts[agent]
+    traj = SimpleNamespace(**tree["traj"])
+    diff = np.array([BIN_INDEX[r["difficulty"]] for r in es.records], np.int64)
+    events = IA.events_from_trajectory(traj, diff)
+    timing = IA.question_timing(events)
+    grids = list(es.bank.navgrids)
+    labels = [[room.label for room in es.bank.scene(i).rooms] for i in range(len(grids))]
+    scene_index = np.asarray(es.specs.scene)
+    loc = IA.type3_locations(grids, np.asarray(traj.pose), events, scene_index=scene_index, room_labels=labels)
+    qpd = IA.questions_per_difficulty(np.asarray(tree["out"]["n_questions"]), diff)
+    du = IA.delta_u(np.asarray(traj.pose), events, h=int(cfg["analysis"]["horizon"]), r=float(cfg["analysis"]["radius"]))
+    fig = out / "figures"
+    IA.plot_question_timing(timing, fig / "analysis_timing.png")
+    IA.plot_location_classes(loc, fig / "analysis_type3_locations.png")
+    IA.plot_questions_per_difficulty(qpd, fig / "analysis_questions_per_difficulty.png")
+    IA.plot_delta_u(du, fig / "analysis_delta_u.png")
+    rows = [[BIN_NAMES[b], float(qpd["mean_total"][b])] + [float(qpd["mean_per_type"][b, t]) for t in range(4)]
+            + [100 * float(du["mean"][b]) if np.isfinite(du["mean"][b]) else float("nan"), int(du["count"][b])]
+            for b in range(3)]
+    header = ["difficulty", "|Q|", "Q1", "Q2", "Q3", "Q4", "Delta-U (%)", "Type-3 questions with a matched horizon"]
+    write_csv(out / "analysis_per_difficulty.csv", header, rows)
+    lheader = ["class", "Type-3 questions", "share"]
+    lrows = [[c, int(n), float(f)] for c, n, f in zip(loc["classes"], loc["counts"], loc["fractions"])]
+    write_csv(out / "analysis_type3_locations.csv", lheader, lrows)
+    plots = plot_trajectories(es, tree, int(cfg["analysis"]["trajectories"]), fig, agent)
+    return {"agent": agent, "per_difficulty": (header, rows), "locations": (lheader, lrows), "timing": timing,
+            "trajectory_plots": plots}
+
+
+QUESTION_STYLE = {1: ("o", "tab:purple"), 2: ("s", "tab:orange"), 3: ("^", "tab:red"), 4: ("D", "tab:green")}
+
+
+def plot_trajectories(es, tree: dict, n: int, folder: Path, agent: str) -> list[Path]:
+    """Top-down plots of a few episodes (one per difficulty first, then in
+    file order): start, path, target, distractors and where each question
+    type was asked."""
+    import matplotlib.pyplot as plt
+
+    from ignjax.scenes.viz.mapplot import plot_scene_map, save_figure
+
+    if n <= 0:
+        return []
+    diff = [r["difficulty"] for r in es.records]
+    order = []
+    for b in BIN_NAMES:
+        order += [i for i, d in enumerate(diff) if d == b][:1]
+    order += [i for i in range(len(diff)) if i not in order]
+    paths = []
+    pose = np.asarray(tree["traj"]["pose"])
+    qs = np.asarray(tree["traj"]["question"])
+    kinds = np.asarray(tree["traj"]["kind"])
+    for i in order[:n]:
+        rec = es.records[i]
+        s = int(np.asarray(es.specs.scene)[i])
+        scene = es.bank.scene(s)
+        fig = plot_scene_map(scene, show_labels=False, title=f"{rec['episode_id']} ({rec['difficulty']}, {agent})")
+        ax = fig.axes[0]
+        used = int((kinds[i] >= 0).sum())
+        xy = pose[i, : used + 1, :2]
+        ax.plot(xy[:, 0], xy[:, 1], "-", color="k", lw=1.8, label="path")
+        ax.plot(xy[0, 0], xy[0, 1], "o", ms=9, mfc="white", mec="k", label="start")
+        ax.plot(xy[-1, 0], xy[-1, 1], "x", ms=9, color="k", label="end")
+        by_id = {inst.id: inst for inst in scene.instances}
+        tgt = by_id.get(rec["target_id"])
+        if tgt is not None:
+            same = [x for x in scene.instances if x.category == tgt.category and x.id != tgt.id]
+            if same:
+                ax.plot([x.position[0] for x in same], [x.position[1] for x in same], "*", ms=12,
+                        color="tab:gray", mec="k", label="distractors")
+            ax.plot(tgt.position[0], tgt.position[1], "*", ms=16, color="gold", mec="k", label="target")
+        for t, (m, c) in QUESTION_STYLE.items():
+            steps = np.nonzero(qs[i, :used] == t)[0]
+            if len(steps):
+                p = pose[i, steps, :2]  # pose before the ASK step
+                ax.plot(p[:, 0], p[:, 1], m, ms=8, color=c, mec="k", label=f"Type {t} asked")
+        ax.legend(fontsize=7, loc="upper right")
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+        path = folder / f"trajectory_{len(paths)}.png"
+        save_figure(fig, path)
+        plt.close(fig)
+        paths.append(path)
+    return paths
+
+
+# ---------------------------------------------------------------------------
+# report
+# ---------------------------------------------------------------------------
+
+
+def write_outputs(results: dict, out: Path) -> None:
+    cfg, studies = results["config"], results["studies"]
+    es = results.get("episodes")
+    rollouts = results.get("rollouts", {})
+    parts = [f"# ignjax sweep: {cfg['run']['name']}", ""]
+    if es is not None:
+        counts = {b: sum(r["difficulty"] == b for r in es.records) for b in BIN_NAMES}
+        parts += [f"Benchmark: {len(es)} episodes in {len(es.bank.scene_ids)} scenes "
+                  f"({', '.join(f'{counts[b]} {b}' for b in BIN_NAMES)}); seed {cfg['run']['seed']}; "
+                  f"locked costs {tuple(cfg['eval']['costs'])}; success = geodesic distance <= threshold"
+                  f"{' and STOP' if cfg['eval']['require_stop'] else ''}.", ""]
+    if "eval" in studies:
+        ev = study_eval(es, rollouts, cfg, out)
+        results["eval"] = ev
+        parts += ["## Evaluation (Table-1 columns)", "",
+                  "SR/OSR and WSR in %, NE and TL in metres, Q_t questions per episode; the Easy/Medium/Hard columns "
+                  "repeat SR@1.5, WSR@1.5 and |Q| per difficulty. `shortest_path` is privileged (an upper bound).", ""]
+        if all(t in cfg["eval"]["thresholds"] for t in (0.5, 1.5, 3.0)):
+            parts += [M.table1(ev["metrics"], "markdown"), ""]
+        parts += ["Per-episode outcomes: `outcomes.parquet`, `outcomes.csv`; metrics: `metrics.csv`.", ""]
+    if "costs" in studies:
+        cs = study_costs(es, rollouts, results.get("in_loop"), cfg, out)
+        results["costs"] = cs
+        res = cs["offline"]
+        fl = res["flips"]
+        parts += ["## Cost-weight sensitivity", "",
+                  f"Offline: the stored outcomes re-weighted under {len(res['costs'])} cost vectors (row 0 locked, "
+                  f"row 1 uniform, the rest uniform on the simplex scaled to the locked sum). WSR@1.5 in %.", "",
+                  md_table(cs["offline_table"][0], [[r[0]] + [100 * v if i < 5 else v for i, v in enumerate(r[1:])]
+                                                    for r in cs["offline_table"][1]]), "",
+                  f"The ranking differs from the locked-cost ranking for {100 * fl['fraction_flipped']:.1f}% of the "
+                  f"cost vectors (mean Kendall tau {fl['tau_mean']:.3f}, min {fl['tau_min']:.3f}). Mean costs where "
+                  f"rankings flip: {np.round(fl['mean_costs_flipped'], 3).tolist()}; where they hold: "
+                  f"{np.round(fl['mean_costs_kept'], 3).tolist()}.", "",
+                  "![WSR against each type's cost](figures/costs_marginal_wsr.png)", "",
+                  "![Where rankings flip](figures/costs_flip_map.png)", ""]
+        if "in_loop_table" in cs:
+            h, rows = cs["in_loop_table"]
+            parts += [f"In the loop: `{cs['in_loop_agent']}` re-run under each charged cost vector (one vmapped call "
+                      "over cost vectors x episodes). Its asking should fall as costs rise.", "",
+                      md_table(h, rows), "", "![Asking vs costs](figures/costs_in_loop.png)", ""]
+    if "difficulty" in studies:
+        ds = study_difficulty(es, rollouts, cfg, out)
+        results["difficulty"] = ds
+        abl = ds["ablation"]
+        p = ds["default_proportions"]
+        parts += ["## Difficulty-coefficient ablation", "",
+                  f"{len(abl['alphas'])} alpha settings on the simplex x {len(abl['thresholds'])} threshold pairs "
+                  f"({ds['n_settings']} settings), on the stored factors. Per-bin SR is ordered easy >= medium >= hard "
+                  f"for every agent in {100 * abl['fraction_ordered']:.1f}% of the settings "
+                  f"(empty-bin rule: {cfg['difficulty']['empty']}). The reference alpha {tuple(cfg['difficulty']['alpha'])} and "
+                  f"thresholds {tuple(cfg['difficulty']['thresholds'])} give bins "
+                  f"{100 * p[0]:.0f}/{100 * p[1]:.0f}/{100 * p[2]:.0f}% of the episodes.", "",
+                  md_table(*ds["default_bins"]), "", "![Ordering](figures/difficulty_ordering.png)", "",
+                  "Calibration (alpha maximising the Spearman correlation between D and failure, mean over agents; "
+                  "fitted on one half of the episodes, reported on the other):", "",
+                  md_table(*ds["calibration_table"]), "", "![Calibration](figures/difficulty_calibration.png)", ""]
+    if "derive-costs" in studies:
+        dc = study_derive_costs(cfg, out)
+        results["derive-costs"] = dc
+        parts += ["## Cost derivation", "",
+                  f"Cue statistics -> U_c = l_s s_c + l_h h_c + l_r r_c -> mention-weighted U_t -> linear rescale into "
+                  f"the locked penalty range. Input: {dc['source']}."
+                  + (f" Cues with assumed statistics (unpublished): {', '.join(map(str, dc['assumed']))}."
+                     if dc["assumed"] else ""), "",
+                  md_table(*dc["table"]), ""]
+    if "analysis" in studies:
+        an = study_analysis(es, rollouts, cfg, out)
+        results["analysis"] = an
+        parts += [f"## Interaction analyses (`{an['agent']}`)", "",
+                  md_table(*an["per_difficulty"]), "",
+                  "Where Type-3 questions were asked (classified from the navigation grid):", "",
+                  md_table(*an["locations"]), "",
+                  "![Timing](figures/analysis_timing.png)", "",
+                  "![Type-3 locations](figures/analysis_type3_locations.png)", "",
+                  "![Questions per difficulty](figures/analysis_questions_per_difficulty.png)", "",
+                  "![Delta-U](figures/analysis_delta_u.png)", ""]
+        for p in an["trajectory_plots"]:
+            parts += [f"![trajectory]({p.relative_to(out).as_posix()})", ""]
+    atomic_write(out / "report.md", "\n".join(parts))
+
+
+__all__ = ["agent_arrays", "factors_of", "md_table", "plot_trajectories", "study_analysis", "study_costs",
+           "study_derive_costs", "study_difficulty", "study_eval", "write_csv", "write_outputs"]

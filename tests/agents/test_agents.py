@@ -1,0 +1,340 @@
+"""The built-in agents on the shared small benchmark: the privileged upper
+bound far above chance, the cost-aware agent asking less as its charged
+costs rise and beating the free asker on WSR, determinism of the asking
+agents, and privileged information reaching only the privileged agent.
+
+Every rollout uses the whole 40-episode set as one batch (one compiled
+shape per agent) with the per-episode keys of :func:`ignjax.sim.rollout.episode_keys`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from functools import partial
+
+import chex
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from ignjax.evaluate import metrics as M
+from ignjax.agents.base import Agent, get_agent, registry
+from ignjax.evaluate.runner import run_agent
+from ignjax.sim.rollout import Privileged, episode_keys, pad_specs, rollout, rollout_episode, rollout_sweep
+from ignjax.sim import types as T
+
+SEED = 0
+SCALES = (0.25, 1.0, 4.0)  # the EIG agent's charged costs: locked costs x these
+
+
+def _batch(es):
+    """Specs and keys of every episode, as one batch (padded rows would be masked out)."""
+    n = len(es)
+    return pad_specs(es.specs, n), episode_keys(SEED, np.arange(n))
+
+
+def _outcomes(out) -> M.Outcomes:
+    return M.Outcomes.from_numpy(final_distance=out.final_distance, min_distance=out.min_distance,
+                                 path_length=out.path_length, stopped=out.stopped, n_questions=out.n_questions,
+                                 difficulty=out.difficulty, valid=out.valid)
+
+
+def _row(out) -> dict:
+    return M.metric_row(_outcomes(out))
+
+
+@pytest.fixture(scope="module")
+def runs(small_benchmark, small_world):
+    """Outcomes (numpy) of random, shortest_path and naive_asker, and the EIG
+    agent under three charged cost vectors in one vmapped call."""
+    es = small_benchmark["set"]
+    specs, keys = _batch(es)
+    res = {}
+    for name in ("random", "shortest_path", "naive_asker"):
+        agent = get_agent(name)
+        res[name] = jax.tree.map(np.asarray, rollout(small_world, specs, agent, agent.default_params(), keys))
+    eig = get_agent("eig")
+    base = eig.default_params()
+    K = len(SCALES)
+    params = jax.tree.map(lambda x: jnp.broadcast_to(x, (K,) + jnp.shape(x)), base)
+    costs = jnp.asarray(M.LOCKED_COSTS, jnp.float32)[None] * jnp.asarray(SCALES, jnp.float32)[:, None]
+    params = dataclasses.replace(params, costs=costs)
+    res["eig_sweep"] = jax.tree.map(np.asarray, rollout_sweep(small_world, specs, eig, params, keys))
+    res["eig_params"] = params
+    return res
+
+
+def _sweep_row(runs, k):
+    """(outcomes, trajectory) of row k of the EIG cost sweep."""
+    return jax.tree.map(lambda a: a[k], runs["eig_sweep"])
+
+
+def test_privileged_shortest_path_far_above_random(runs):
+    sp, rnd = _row(runs["shortest_path"][0]), _row(runs["random"][0])
+    assert sp["episodes"] == rnd["episodes"] == 40
+    assert sp["SR@1.5"] >= rnd["SR@1.5"] + 50, (sp["SR@1.5"], rnd["SR@1.5"])
+    assert sp["|Q|"] == 0 and rnd["|Q|"] == 0  # neither asks
+
+
+def test_eig_asks_less_as_charged_costs_rise(runs):
+    out, traj = runs["eig_sweep"]
+    q = np.asarray(out.n_questions).sum(-1).mean(-1)  # (K,) mean |Q| per episode
+    assert np.all(np.diff(q) <= 0), dict(zip(SCALES, q))
+    assert q[-1] < q[0], dict(zip(SCALES, q))
+    # every charged question is an ASK step of its type in the trajectory (refused ones are not charged)
+    asked = np.stack([((np.asarray(traj.kind) == T.ASK) & (np.asarray(traj.question) == t)).sum(-1)
+                      for t in range(1, 5)], -1)
+    assert np.all(asked >= np.asarray(out.n_questions))
+
+
+def test_eig_beats_naive_asker_on_wsr(runs):
+    eig = _row(_sweep_row(runs, SCALES.index(1.0))[0])  # the sweep's x1 row: the EIG agent at the locked costs
+    naive = _row(runs["naive_asker"][0])
+    assert eig["WSR@1.5"] > naive["WSR@1.5"], (eig["WSR@1.5"], naive["WSR@1.5"])
+
+
+def test_asking_agents_are_deterministic(small_benchmark, small_world, runs):
+    """Same keys, same outcomes and trajectories: again through the same
+    compiled call, and through :func:`run_agent` (same batch shape, so no
+    new compile); other keys give other trajectories."""
+    es = small_benchmark["set"]
+    specs, keys = _batch(es)
+    eig = get_agent("eig")
+    again = jax.tree.map(np.asarray, rollout_sweep(small_world, specs, eig, runs["eig_params"], keys))
+    chex.assert_trees_all_equal(again, runs["eig_sweep"])
+    naive = run_agent(es, "naive_asker", batch=len(es), seed=SEED, world=small_world)
+    chex.assert_trees_all_equal(naive, runs["naive_asker"])
+    other = run_agent(es, "naive_asker", batch=len(es), seed=SEED + 1, world=small_world)
+    assert not np.array_equal(other[1].pose, runs["naive_asker"][1].pose)
+
+
+def test_only_the_privileged_agent_receives_privileged_information(small_benchmark, small_world):
+    """The registry's flag, and what ``act`` is actually handed during a
+    rollout (traced with ``eval_shape``: no compile)."""
+    reg = registry()
+    assert {n for n, a in reg.items() if a.privileged} == {"shortest_path"}
+    es = small_benchmark["set"]
+    spec = jax.tree.map(lambda a: a[0], es.specs)
+    for name, agent in reg.items():
+        seen = []
+
+        def act(params, obs, answers, pstate, key, priv, _act=agent.act, _seen=seen):
+            _seen.append(priv)
+            return _act(params, obs, answers, pstate, key, priv)
+
+        spy = Agent(name, agent.init, act, agent.default_params, agent.privileged, agent.asks, agent.description)
+        jax.eval_shape(lambda k, spy=spy: rollout_episode(small_world, spec, spy, spy.default_params(), k)[:2],
+                       jax.random.key(0))
+        assert seen, name
+        if agent.privileged:
+            assert all(isinstance(p, Privileged) for p in seen), name
+        else:
+            assert all(p is None for p in seen), name
+
+
+def _reference_likelihoods(mem, obs):
+    """The EIG agent's answer models as explicit (A, hypotheses) likelihood
+    matrices (see :mod:`ignjax.agents.policies`), for one episode."""
+    import math
+
+    from ignjax.agents import policies as P
+    from ignjax.agents.base import candidate_relative
+
+    L_, C_ = P.N_ROOM_LABELS, P.N_COLORS
+    U = L_ * 8
+    valid = (mem.handle >= 0) & ~mem.rejected
+    col = mem.attrs[:, 0]
+    L1 = jnp.concatenate([jnp.where(col[None] >= 0, (jnp.arange(C_)[:, None] == col[None]).astype(jnp.float32), 1.0 / C_),
+                          jnp.full((C_, U), 1.0 / C_)], axis=1)
+    L2 = jnp.concatenate([jnp.where(mem.room[None] >= 0, (jnp.arange(L_)[:, None] == mem.room[None]).astype(jnp.float32),
+                                    1.0 / L_),
+                          (jnp.arange(L_)[:, None] == jnp.repeat(jnp.arange(L_), 8)[None]).astype(jnp.float32)], axis=1)
+    dist, bearing = candidate_relative(mem, obs)
+    cs = (jnp.round(bearing / (math.pi / 4)).astype(jnp.int32)) % 8
+    u_rel = jnp.tile(P._abs_sector(obs), L_)
+    a = jnp.arange(8)[:, None]
+    L3 = jnp.concatenate([P._sector_likelihood(a, cs[None]), P._sector_likelihood(a, u_rel[None])], axis=1)
+    L3 = L3 / L3.sum(0, keepdims=True)
+    in_front = valid & (dist <= 3.0) & (jnp.abs(bearing) <= math.pi / 4) & jnp.isin(mem.handle, obs.visible_handle)
+    return (L1, L2, L3), in_front
+
+
+def test_question_eigs_equal_eq1_on_explicit_answer_models(small_benchmark, small_world):
+    """The agent's structured EIG per question type equals Eq. (1),
+    H[b] - E_a H[b | a], evaluated directly on the explicit likelihood
+    matrices of its answer models, along real rollouts."""
+    from ignjax.agents import policies as P
+    from ignjax.sim import env as E
+
+    es = small_benchmark["set"]
+    specs, keys = _batch(es)
+    agent = get_agent("eig")
+    params = agent.default_params()
+    state = jax.vmap(lambda s: E.reset(small_world, s))(specs)
+    obs = jax.vmap(lambda st: E.observe(small_world, st))(state)
+    pst = jax.vmap(lambda o, k: agent.init(params, o, k))(obs, keys)
+    act = jax.jit(jax.vmap(lambda o, a, p, k: agent.act(params, o, a, p, k, None)))
+    step = jax.jit(jax.vmap(lambda st, a: E.step(small_world, st, a)))
+    observe = jax.jit(jax.vmap(lambda st: E.observe(small_world, st)))
+
+    def check(o, ans, mem):
+        mem, b = P._prepare(params, o, ans, mem)
+        got, slot = P.question_eigs(mem, o, ans, b)
+        (L1, L2, L3), in_front = _reference_likelihoods(mem, o)
+        M_ = mem.handle.shape[0]
+        yes = jnp.concatenate([(jnp.arange(M_) == slot).astype(jnp.float32), jnp.zeros(b.shape[0] - M_)])
+        L4 = jnp.stack([yes, 1.0 - yes])
+        ref = jnp.stack([P.expected_information_gain(b, L) for L in (L1, L2, L3, L4)])
+        ref = ref * jnp.stack([~ans.known[0], ~ans.known[1], jnp.array(True), jnp.any(in_front)])
+        return got, jnp.maximum(ref, 0.0), slot, jnp.where(jnp.any(in_front), jnp.argmax(jnp.where(in_front, b[:M_], -1.0)), -1)
+
+    check = jax.jit(jax.vmap(check))
+    n_positive = 0
+    for _ in range(8):
+        got, ref, slot, ref_slot = (np.asarray(x) for x in check(obs, state.answers, pst))
+        np.testing.assert_allclose(got, ref, atol=2e-5)
+        np.testing.assert_array_equal(slot, ref_slot)
+        n_positive += int((ref > 1e-3).sum())
+        a, pst = act(obs, state.answers, pst, keys)
+        state = step(state, a)
+        obs = observe(state)
+    assert n_positive > 50  # the comparison saw informative questions
+
+
+def _rows_matching(got, want) -> np.ndarray:
+    """(E,) bool: episodes whose discrete fields are equal and continuous ones
+    equal to float32 rounding, over every leaf of (outcome, trajectory)."""
+    ok = None
+    for a, b in zip(jax.tree.leaves(got), jax.tree.leaves(want)):
+        a, b = np.asarray(a), np.asarray(b)
+        if a.dtype.kind == "f":
+            same = np.isclose(a, b, atol=1e-4, rtol=1e-5) | (np.isinf(a) & (a == b))
+        else:
+            same = a == b
+        same = same.reshape(a.shape[0], -1).all(1)
+        ok = same if ok is None else ok & same
+    return ok
+
+
+@pytest.mark.parametrize("name", ["shortest_path", "naive_asker", "eig"])
+def test_batched_rollout_equals_one_episode_rollout(small_benchmark, small_world, runs, name):
+    """The batch rollout (executor for the movers only, oracle for the askers
+    only, nothing for finished rows; rollout_sweep's K x E rows) gives row for
+    row what the one-episode reference ``rollout_episode`` gives under vmap,
+    compiled with the same options. Vectorising over other widths changes the
+    last bits of float32 results, and the protocol's thresholds (waypoint
+    reached, heading free, EIG / cost above the threshold) can turn that into
+    another decision in a rare episode, so up to 1 in 20 episodes may differ;
+    a change of behaviour would show in most of them."""
+    from ignjax.sim.rollout import ROLLOUT_COMPILER_OPTIONS
+
+    es = small_benchmark["set"]
+    specs, keys = _batch(es)
+    agent = get_agent(name)
+    if name == "eig":
+        k = SCALES.index(1.0)
+        params, got = jax.tree.map(lambda a: a[k], runs["eig_params"]), _sweep_row(runs, k)
+    else:
+        params, got = agent.default_params(), runs[name]
+    ref = jax.jit(jax.vmap(lambda s, key: rollout_episode(small_world, s, agent, params, key)[:2]),
+                  compiler_options=ROLLOUT_COMPILER_OPTIONS)(specs, keys)
+    same = _rows_matching(got, ref)
+    assert same.mean() >= 0.95, f"{name}: {int((~same).sum())} of {same.size} episodes differ: {np.flatnonzero(~same)}"
+
+
+def test_sweep_simulates_each_distinct_trajectory_once_with_the_same_result(small_benchmark, small_world, runs):
+    """rollout_sweep simulates the settings of an episode that act alike once
+    (group mode); the result equals every row simulated on its own, exactly
+    (same chunk width in both, so the same vectorised code runs per row)."""
+    from ignjax.sim.rollout import ROLLOUT_COMPILER_OPTIONS, rollout_rows
+
+    es = small_benchmark["set"]
+    specs, keys = _batch(es)
+    eig, params = get_agent("eig"), runs["eig_params"]
+    n, K = specs.scene.shape[0], len(SCALES)
+
+    @partial(jax.jit, compiler_options=ROLLOUT_COMPILER_OPTIONS)
+    def each_row(specs, params, keys):
+        tile = jnp.tile(jnp.arange(n), K)
+        rows = jax.tree.map(lambda x: jnp.repeat(x, n, axis=0), params)
+        out = rollout_rows(small_world, jax.tree.map(lambda a: a[tile], specs), eig, rows, keys[tile], 8)[:2]
+        return jax.tree.map(lambda a: a.reshape((K, n) + a.shape[1:]), out)
+
+    want = jax.tree.map(np.asarray, each_row(specs, params, keys))
+    got = jax.tree.map(np.asarray, rollout_sweep(small_world, specs, eig, params, keys, chunk=8))
+    chex.assert_trees_all_equal(got, want)
+    # the settings do share work: in most episodes two settings take the same first actions
+    first = want[1].kind[:, :, :2] * 5 + want[1].question[:, :, :2]
+    shared = np.any([np.all(first[i] == first[j], axis=1) for i in range(K) for j in range(i)], axis=0)
+    assert shared.mean() > 0.5, shared.mean()
+
+
+def test_visit_counts_saturate_instead_of_wrapping(small_benchmark, small_world):
+    from ignjax.agents.base import Memory, _visit_index, observe_memory
+    from ignjax.sim import env as E
+
+    spec = jax.tree.map(lambda a: a[0], small_benchmark["set"].specs)
+    obs = E.observe(small_world, E.reset(small_world, spec))
+    ij = np.asarray(_visit_index(obs.odometry[:2]))
+    mem = Memory.empty()
+    once = observe_memory(mem, obs)
+    assert int(once.visits[ij[1], ij[0]]) == 1 and int(once.visits.sum()) == 1
+    full = dataclasses.replace(mem, visits=mem.visits.at[ij[1], ij[0]].set(254))
+    for _ in range(2):
+        full = observe_memory(full, obs)
+    assert int(full.visits[ij[1], ij[0]]) == 255
+
+
+def test_batch_parts_depend_on_the_batch_and_backend_only():
+    from ignjax.sim.rollout import MIN_PART_ROWS, PARTS, batch_parts
+
+    cpu = jax.default_backend() == "cpu"
+    assert batch_parts(PARTS * MIN_PART_ROWS) == (PARTS if cpu else 1)
+    assert batch_parts(PARTS * MIN_PART_ROWS - 1) == 1
+    assert batch_parts(1000, 8) == 8 and batch_parts(3, 8) == 3 and batch_parts(50, 0) == 1
+
+
+def test_pieces_are_split_padded_and_joined_in_order(small_benchmark, small_world):
+    """A batch run in pieces (the last padded with finished copies) gives
+    each row what one call on the whole batch gives it, on both output layouts."""
+    from ignjax.sim.rollout import _EXECUTABLES, _in_parts
+
+    @partial(jax.jit, static_argnames=("agent", "chunk"))
+    def rows(world, specs, agent, params, keys, chunk=None):
+        v = specs.field * 1000 + specs.target * 10 + specs.valid + jax.random.randint(keys[0], (), 0, 3) * 0
+        return v * params, jax.random.key_data(keys)
+
+    @partial(jax.jit, static_argnames=("agent", "chunk"))
+    def settings(world, specs, agent, params, keys, chunk=None):
+        return (params[:, None] * (specs.field * 1000 + specs.target)[None],)
+
+    es = small_benchmark["set"]
+    specs, keys = _batch(es)
+    n = specs.scene.shape[0]
+    before = len(_EXECUTABLES)
+    for parts in (2, 3, 7):
+        got = _in_parts(rows, small_world, specs, "toy", jnp.int32(3), keys, None, parts, 0)
+        chex.assert_trees_all_equal(got, rows(small_world, specs, "toy", jnp.int32(3), keys))
+        assert got[0].shape == (n,)
+    assert len(_EXECUTABLES) == before + 3  # one program per piece shape, however many pieces run it
+    k = jnp.arange(1, 5, dtype=jnp.int32)
+    got = _in_parts(settings, small_world, specs, "toy", k, keys, None, 3, 1)
+    chex.assert_trees_all_equal(got, settings(small_world, specs, "toy", k, keys))
+    # under a trace the pieces are not split (the caller's program holds the whole batch)
+    shape = jax.eval_shape(lambda s, kk: _in_parts(rows, small_world, s, "toy", jnp.int32(3), kk, None, 3, 0), specs, keys)
+    assert shape[0].shape == (n,)
+
+
+def test_rollout_in_pieces_gives_each_episode_its_own_result(small_benchmark, small_world, runs):
+    """A rollout as two concurrent pieces: the episodes' results match the
+    one-piece rollout (up to float rounding, as between chunk widths) and
+    repeat exactly."""
+    es = small_benchmark["set"]
+    specs, keys = _batch(es)
+    agent = get_agent("naive_asker")
+    got = jax.tree.map(np.asarray, rollout(small_world, specs, agent, agent.default_params(), keys, parts=2))
+    again = jax.tree.map(np.asarray, rollout(small_world, specs, agent, agent.default_params(), keys, parts=2))
+    chex.assert_trees_all_equal(got, again)
+    same = _rows_matching(got, runs["naive_asker"])
+    assert same.mean() >= 0.95, np.flatnonzero(~same)

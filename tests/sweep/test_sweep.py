@@ -1,0 +1,210 @@
+"""The main job, ``python -m ignjax.sweep``: studies on the shared small
+benchmark, outputs recomputable from the outcome tables, resume after
+SIGKILL with identical bytes, and bad input rejected before any work."""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ignjax.errors import ConfigError, InputError
+from ignjax.sweep.runner import main, run_sweep
+from ignjax.config import DEFAULTS, parse_set, resolve
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def _sets(path, out_root) -> list[str]:
+    return [f"benchmark.episodes='{path}'", f"run.out='{out_root}'", "eval.agents=['random', 'eig']",
+            "eval.batch=16", "costs.samples=500", "costs.scales=[0.25, 4.0]", "costs.per_type_factor=0.0",
+            "analysis.trajectories=1"]
+
+
+@pytest.fixture(scope="module")
+def sweep_run(small_benchmark, tmp_path_factory):
+    root = tmp_path_factory.mktemp("sweep")
+    cfg = resolve(None, _sets(small_benchmark["path"], root), quick=True)
+    out = root / "full"
+    res = run_sweep(cfg, ["eval", "costs", "difficulty", "derive-costs", "analysis"], out, quiet=True)
+    return {"cfg": cfg, "out": out, "res": res, "root": root}
+
+
+def test_report_and_tables_are_written(sweep_run):
+    out = sweep_run["out"]
+    report = (out / "report.md").read_text()
+    for section in ("## Evaluation", "## Cost-weight sensitivity", "## Difficulty-coefficient ablation",
+                    "## Cost derivation", "## Interaction analyses"):
+        assert section in report
+    for name in ("outcomes.parquet", "outcomes.csv", "metrics.csv", "costs_offline.csv", "costs_in_loop.csv",
+                 "difficulty_default_bins.csv", "difficulty_calibration.csv", "derive_costs.csv",
+                 "analysis_per_difficulty.csv", "analysis_type3_locations.csv"):
+        assert (out / name).is_file(), name
+    figs = sorted(p.name for p in (out / "figures").glob("*.png"))
+    assert "costs_in_loop.png" in figs and "trajectory_0.png" in figs and len(figs) >= 10
+    for f in figs:  # every figure the report embeds exists
+        assert (out / "figures" / f).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    for ref in [line.split("(")[1].rstrip(")") for line in report.splitlines() if line.startswith("![")]:
+        assert (out / ref).is_file(), ref
+
+
+def test_wsr_columns_recompute_from_outcomes_alone(sweep_run):
+    """metrics.csv's WSR@t equals a plain loop over outcomes.csv rows."""
+    out = sweep_run["out"]
+    costs = sweep_run["cfg"]["eval"]["costs"]
+    with open(out / "outcomes.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    with open(out / "metrics.csv") as fh:
+        metrics = {r["agent"]: r for r in csv.DictReader(fh)}
+    assert set(metrics) == {"random", "eig"}
+    for agent, m in metrics.items():
+        mine = [r for r in rows if r["agent"] == agent]
+        assert len(mine) == 40
+        for thr in (1.5, 3.0):
+            total = 0.0
+            for r in mine:
+                ok = float(r["final_distance"]) <= thr and r["stopped"] in ("True", "true", "1")
+                n = [int(r[f"q{t}"]) for t in range(1, 5)]
+                total += ok * math.exp(-sum(c * k for c, k in zip(costs, n)))
+            assert float(m[f"WSR@{thr:g}"]) == pytest.approx(100 * total / len(mine), abs=1e-3)
+
+
+def test_in_loop_asking_falls_as_costs_rise(sweep_run):
+    table = sweep_run["res"]["costs"]["in_loop_table"]
+    header, rows = table
+    q = {r[0]: r[header.index("|Q|")] for r in rows}
+    assert q["all x0.25"] > q["all x4"], q
+
+
+def test_offline_study_reference_rows(sweep_run):
+    res = sweep_run["res"]["costs"]["offline"]
+    assert np.allclose(res["costs"][0], DEFAULTS["eval"]["costs"])
+    assert res["tau"][0] == pytest.approx(1.0)
+    metrics = sweep_run["res"]["eval"]["metrics"]
+    for a, name in enumerate(res["agent_names"]):  # row 0 (locked costs) reproduces the evaluation's WSR@1.5
+        assert 100 * res["wsr_ranked"][0, a] == pytest.approx(metrics[name]["WSR@1.5"], abs=1e-3)
+
+
+def test_resume_after_sigkill_gives_identical_outputs(sweep_run, small_benchmark, tmp_path):
+    """Kill a run with SIGKILL after its first checkpoint, resume it: same bytes as the uninterrupted run."""
+    out = tmp_path / "killed"
+    args = [sys.executable, "-m", "ignjax.sweep", "--quick", "--quiet", "--out", str(out)]
+    for s in _sets(small_benchmark["path"], sweep_run["root"]):
+        args += ["--set", s]
+    env = dict(os.environ, PYTHONHASHSEED="0")
+    proc = subprocess.Popen(args, cwd=REPO, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    ck = out / "checkpoints"
+    deadline = time.time() + 300
+    while time.time() < deadline and proc.poll() is None:
+        if ck.is_dir() and any(p.is_dir() and not p.name.endswith(".partial") for p in ck.iterdir()):
+            break
+        time.sleep(0.2)
+    assert proc.poll() is None, "the run ended before it could be interrupted: " + proc.stderr.read().decode()[-2000:]
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    assert not (out / "report.md").exists()
+    # without --resume the folder is refused
+    refused = subprocess.run(args, cwd=REPO, env=env, capture_output=True, text=True)
+    assert refused.returncode == 2 and "--resume" in refused.stderr
+    done = subprocess.run(args + ["--resume"], cwd=REPO, env=env, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr[-3000:]
+    full = sweep_run["out"]
+    files = sorted(p.relative_to(full) for p in full.rglob("*") if p.is_file() and "checkpoints" not in p.parts)
+    assert files == sorted(p.relative_to(out) for p in out.rglob("*") if p.is_file() and "checkpoints" not in p.parts)
+    for f in files:
+        assert (full / f).read_bytes() == (out / f).read_bytes(), f
+
+
+# ---------------------------------------------------------------------------
+# bad input: clear errors before any work
+# ---------------------------------------------------------------------------
+
+
+def _err(capsys, argv) -> str:
+    assert main(argv) == 2
+    return capsys.readouterr().err
+
+
+def test_unknown_study_and_agent(capsys, tmp_path):
+    assert "unknown study 'speed'" in _err(capsys, ["--study", "speed", "--out", str(tmp_path / "a")])
+    assert "unknown agent 'oracle'" in _err(capsys, ["--set", "eval.agents=['oracle']", "--out", str(tmp_path / "b")])
+    assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()
+
+
+def test_malformed_toml_names_file_and_line(tmp_path, capsys):
+    p = tmp_path / "bad.toml"
+    p.write_text("[costs]\nsamples = 10\nscales = [1.0, \n")
+    err = _err(capsys, ["--config", str(p)])
+    assert "bad.toml:" in err and "malformed TOML" in err
+    p.write_text("[costs]\nsamples = 10\nsample_count = 3\n")
+    err = _err(capsys, ["--config", str(p)])
+    assert "bad.toml:3" in err and "costs.sample_count" in err
+    p.write_text("[costz]\nsamples = 10\n")
+    assert "unknown section" in _err(capsys, ["--config", str(p)])
+
+
+def test_set_items_are_checked():
+    with pytest.raises(ConfigError, match="unknown key costs.nope"):
+        parse_set("costs.nope=3")
+    with pytest.raises(ConfigError, match="section.key=value"):
+        parse_set("samples")
+    with pytest.raises(ConfigError, match="expected an integer"):
+        resolve(None, ["costs.samples='many'"])
+    assert resolve(None, ["costs.samples=7"])["costs"]["samples"] == 7
+
+
+@pytest.mark.parametrize("costs, reason", [("[-0.1, 0.1, 0.1, 0.1]", "negative"), ("[nan, 0.1, 0.1, 0.1]", "finite"),
+                                           ("[0.0, 0.0, 0.0, 0.0]", "zero")])
+def test_bad_costs(costs, reason):
+    with pytest.raises((ConfigError, InputError), match=reason):
+        resolve(None, [f"eval.costs={costs}"])
+
+
+def test_alpha_must_be_on_the_simplex_unless_normalised():
+    with pytest.raises(ConfigError, match="negative"):
+        resolve(None, ["difficulty.alpha=[-0.1, 0.5, 0.3, 0.3]"])
+    with pytest.raises(ConfigError, match="sum to 1"):
+        resolve(None, ["difficulty.alpha=[1.0, 1.0, 1.0, 1.0]"])
+    cfg = resolve(None, ["difficulty.alpha=[1.0, 1.0, 1.0, 1.0]", "difficulty.normalize=true"])
+    assert cfg["difficulty"]["alpha"] == [0.25, 0.25, 0.25, 0.25]
+    with pytest.raises(ConfigError, match="thresholds"):
+        resolve(None, ["difficulty.thresholds=[0.6, 0.3]"])
+
+
+def test_empty_episode_file_is_rejected(tmp_path, capsys):
+    import gzip
+
+    p = tmp_path / "empty.jsonl.gz"
+    with gzip.open(p, "wt") as fh:
+        fh.write("")
+    err = _err(capsys, ["--study", "eval", "--set", f"benchmark.episodes='{p}'", "--out", str(tmp_path / "r")])
+    assert "empty.jsonl.gz" in err and ("no episodes" in err or "empty" in err)
+
+
+def test_folder_with_another_run_is_refused(sweep_run, tmp_path):
+    cfg = resolve(None, _sets("x.jsonl.gz", sweep_run["root"]) + ["costs.samples=999"], quick=True)
+    with pytest.raises(InputError, match="different run"):
+        run_sweep(cfg, ["derive-costs"], sweep_run["out"], resume=True)
+    foreign = tmp_path / "foreign"
+    foreign.mkdir()
+    (foreign / "notes.txt").write_text("mine")
+    with pytest.raises(InputError, match="holds no ignjax run"):
+        run_sweep(cfg, ["derive-costs"], foreign)
+    assert (foreign / "notes.txt").read_text() == "mine"
+    run_sweep(cfg, ["derive-costs"], foreign, force=True)  # --force replaces it
+    assert (foreign / "derive_costs.csv").is_file() and not (foreign / "notes.txt").exists()
+
+
+def test_help_lists_every_option():
+    out = subprocess.run([sys.executable, "-m", "ignjax.sweep", "--help"], cwd=REPO, capture_output=True, text=True)
+    assert out.returncode == 0
+    for opt in ("--study", "--config", "--set", "--out", "--quick", "--resume", "--force"):
+        assert opt in out.stdout
