@@ -17,9 +17,9 @@ import os
 import numpy as np
 import pytest
 
-from ignjax.scenes.procgen import catalogue as cat
 from ignjax.scenes import vocab
 from ignjax.scenes.model import Attributes, Geom
+from ignjax.scenes.procgen import catalogue as cat
 
 TOL = 1e-6
 MAX_GEOMS = 48

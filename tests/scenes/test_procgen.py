@@ -17,11 +17,11 @@ import pytest
 from scipy import ndimage
 
 from ignjax.errors import ConfigError
-from ignjax.scenes.procgen import catalogue as cat
 from ignjax.scenes import graph, vocab
-from ignjax.scenes.procgen.catalogue import Built, CategorySpec, Surface
 from ignjax.scenes.model import polygon_area, scene_to_json
-from ignjax.scenes.procgen.generate import HouseParams, generate_house, generate_houses, house_info
+from ignjax.scenes.procgen import HouseParams, generate_house, generate_houses, house_info
+from ignjax.scenes.procgen import catalogue as cat
+from ignjax.scenes.procgen.catalogue import Built, CategorySpec, Surface
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
@@ -145,7 +145,7 @@ def test_same_seed_gives_equal_scene_and_other_seed_differs():
 
 
 def test_same_bytes_in_another_process_with_other_hash_seed():
-    code = ("import hashlib; from ignjax.scenes.procgen.generate import generate_house; "
+    code = ("import hashlib; from ignjax.scenes.procgen import generate_house; "
             "from ignjax.scenes.model import scene_to_json; "
             "print(hashlib.sha256(scene_to_json(generate_house(11)).encode()).hexdigest())")
     env = dict(os.environ, PYTHONHASHSEED="12345", PYTHONPATH=ROOT)
