@@ -20,17 +20,8 @@ import pytest
 from ignjax.errors import SceneError
 from ignjax.scenes.io import sources as scene_io
 from ignjax.scenes.model import scene_to_json
-from ignjax.scenes.io.procthor import (
-    DEFAULT_ASSET_TABLE,
-    AssetInfo,
-    derive_asset_table,
-    house_to_scene,
-    load_asset_table,
-    load_procthor,
-    main,
-    unity_to_world,
-    unity_yaw,
-)
+from ignjax.scenes.io.procthor import house_to_scene, load_procthor, unity_to_world, unity_yaw
+from ignjax.scenes.io.procthor_assets import DEFAULT_ASSET_TABLE, AssetInfo, derive_asset_table, load_asset_table, main
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -466,10 +457,10 @@ def test_derive_assets_command(shared_data, tmp_path, capsys):
     assert main(["derive-assets", str(db), "--out", str(out)]) == 0
     assert "1653 assets of 109 object types" in capsys.readouterr().out
     assert load_asset_table(out)["Fridge_1"] == load_asset_table()["Fridge_1"]
-    r = subprocess.run([sys.executable, "-m", "ignjax.scenes.io.procthor", "derive-assets", "--help"],
+    r = subprocess.run([sys.executable, "-m", "ignjax.scenes.io.procthor_assets", "derive-assets", "--help"],
                        capture_output=True, text=True, cwd=ROOT, timeout=60)
     assert r.returncode == 0 and "--out" in r.stdout
-    r = subprocess.run([sys.executable, "-m", "ignjax.scenes.io.procthor", "derive-assets", str(tmp_path / "x.json")],
+    r = subprocess.run([sys.executable, "-m", "ignjax.scenes.io.procthor_assets", "derive-assets", str(tmp_path / "x.json")],
                        capture_output=True, text=True, cwd=ROOT, timeout=60)
     assert r.returncode == 2 and "x.json" in r.stderr
 

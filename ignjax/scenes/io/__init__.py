@@ -1,0 +1,5 @@
+"""Scene readers and writers: :mod:`.sources` (read any source, by file type),
+:mod:`.usd` (USD import and export), :mod:`.procthor` (ProcTHOR houses) with
+:mod:`.procthor_assets` (its asset table), :mod:`.meshes` (glTF/GLB/OBJ),
+:mod:`.manifest` (scene-folder manifests); shared pieces: :mod:`.formats`
+(file suffixes) and :mod:`.footprint` (2-D hulls and boxes)."""

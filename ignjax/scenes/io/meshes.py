@@ -80,6 +80,8 @@ import numpy as np
 
 from ignjax.errors import SceneError
 from ignjax.scenes import vocab
+from ignjax.scenes.io.footprint import outline_hull
+from ignjax.scenes.io.formats import MESH_SUFFIXES, SIDECAR_SUFFIX
 from ignjax.scenes.model import (  # noqa: I001
     room_containing,
     Attributes,
@@ -96,8 +98,6 @@ from ignjax.scenes.model import (  # noqa: I001
 
 __all__ = ["SIDECAR_SUFFIX", "MESH_SUFFIXES", "Sidecar", "sidecar_path", "read_sidecar", "load_mesh_scene"]
 
-from ignjax.scenes.io.sources import SIDECAR_SUFFIX  # noqa: E402  (one definition, shared with folder loading)
-MESH_SUFFIXES = (".gltf", ".glb", ".obj")
 ROOM_SNAP_DISTANCE = 0.3
 _SIDECAR_KEYS = ("scene_id", "up_axis", "meters_per_unit", "categories", "structural", "rooms")
 _DEFAULT_RGBA = (0.7, 0.7, 0.7, 1.0)
@@ -249,28 +249,6 @@ def read_sidecar(source: str | os.PathLike | Mapping[str, Any] | None) -> Sideca
 def _clean(v: float) -> float:
     """Round to a nanometre so that float noise (-1e-17) does not leak out."""
     return round(float(v), 9) + 0.0
-
-
-def _convex_hull(points: np.ndarray) -> np.ndarray:
-    """Counter-clockwise convex hull (monotone chain) of (N, 2) points."""
-    pts = np.unique(np.round(points, 9), axis=0)
-    if len(pts) < 3:
-        return pts
-
-    def cross(o, a, b):
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-    lower: list[np.ndarray] = []
-    for p in pts:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
-            lower.pop()
-        lower.append(p)
-    upper: list[np.ndarray] = []
-    for p in pts[::-1]:
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
-            upper.pop()
-        upper.append(p)
-    return np.array(lower[:-1] + upper[:-1])
 
 
 def _visual_rgba(geom) -> tuple[tuple[float, float, float, float], bool]:
@@ -439,7 +417,7 @@ def load_mesh_scene(path: str | os.PathLike, *, sidecar: str | os.PathLike | Map
     if side.rooms:
         rooms = side.rooms
     else:
-        hull = _convex_hull(np.concatenate(all_xy))
+        hull = outline_hull(np.concatenate(all_xy))
         if len(hull) < 3 or polygon_problem(hull) is not None:
             raise SceneError(p, None, "cannot derive a room: the geometry's floor footprint has no area "
                                       "(give rooms in a sidecar)")

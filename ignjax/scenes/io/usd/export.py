@@ -1,11 +1,6 @@
-"""USD stages: export a :class:`~ignjax.scenes.model.Scene` and import any stage.
-
-Public API
-    :func:`save_usd` writes a scene as a stage (``.usda``, ``.usdc``, ``.usd``
-    or ``.usdz``); :func:`load_usd` reads any stage into a scene (the
-    machinery lives in :mod:`ignjax.scenes.io.usd_import`). Small helpers:
-    :func:`open_stage`, :func:`stage_up_axis`, :func:`stage_meters_per_unit`,
-    :func:`prim_semantic_label`, :func:`triangulate_faces`.
+"""Export a :class:`~ignjax.scenes.model.Scene` as a USD stage
+(:func:`save_usd`, :func:`scene_to_stage`); :func:`~ignjax.scenes.io.usd.load_usd`
+reads it back without loss.
 
 Exported layout
     ``upAxis = "Z"``, ``metersPerUnit = 1``, ``defaultPrim = "World"``::
@@ -46,8 +41,6 @@ Exported layout
     colour/material/size/state; per geom kind/size/pos/quat/rgba/part/
     material (and, when ``float`` points would round the vertices, the
     exact vertices as ``double3[]``).
-
-Importing: see :func:`load_usd` and :mod:`ignjax.scenes.io.usd_import`.
 """
 
 from __future__ import annotations
@@ -56,266 +49,24 @@ import dataclasses
 import json
 import math
 import os
-import re
 import shutil
 import tempfile
 from pathlib import Path
-from typing import Iterable
 
 import numpy as np
+from pxr import Gf, Kind, Sdf, Tf, Usd, UsdGeom, UsdSemantics, UsdUtils, Vt
 
 from ignjax.errors import SceneError
+from ignjax.scenes.io.formats import USD_SUFFIXES
+from ignjax.scenes.io.usd.stage import ATTR_ID, ATTR_KIND, ISAAC_DATA_ATTR, ISAAC_TYPE_ATTR, LABELS_TAXONOMY, NS
 from ignjax.scenes.model import Door, Geom, Instance, Room, Scene, Wall, validate_scene
-
-USD_SUFFIXES: tuple[str, ...] = (".usd", ".usda", ".usdc", ".usdz")
 
 USD_FORMAT = "ignjax-scene-usd"
 """Value of ``customLayerData["ignjax"]["format"]`` in exported stages."""
 USD_FORMAT_VERSION = 1
 
-NS = "ignjax:"
-ATTR_KIND = NS + "kind"
-"""Token naming what an ``ignjax`` prim is: scene, room, wall, door,
-instance, geom or bbox."""
-ATTR_ID = NS + "id"
-
-ISAAC_TYPE_ATTR = "semantic:Semantics:params:semanticType"
-ISAAC_DATA_ATTR = "semantic:Semantics:params:semanticData"
-LABELS_TAXONOMY = "class"
-LABELS_ATTR = f"semantics:labels:{LABELS_TAXONOMY}"
-
-
-class UsdImportWarning(UserWarning):
-    """Something in a stage was skipped or repaired on import (a missing
-    sublayer, reference or payload, an invalid ``defaultPrim``, prims of
-    unsupported types)."""
-
-
-# ---------------------------------------------------------------------------
-# Shared helpers (also used by the importer)
-# ---------------------------------------------------------------------------
-
-
-def open_stage(path: str | os.PathLike):
-    """Open a stage with all payloads loaded.
-
-    Raises:
-        SceneError: the file is missing or is not a USD file USD can open.
-    """
-    from pxr import Tf, Usd
-
-    p = Path(path)
-    if not p.exists():
-        raise SceneError(p, None, "no such file")
-    if p.is_dir():
-        raise SceneError(p, None, "is a directory, not a USD file")
-    try:
-        stage = Usd.Stage.Open(str(p), load=Usd.Stage.LoadAll)
-    except Tf.ErrorException as e:
-        reason = " ".join(str(e).split())
-        raise SceneError(p, None, f"not a readable USD file ({reason[:300]})") from e
-    if stage is None:
-        raise SceneError(p, None, "not a readable USD file")
-    return stage
-
-
-def stage_up_axis(stage, path: str | os.PathLike | None = None) -> str:
-    """The stage's ``upAxis``: ``"Y"`` or ``"Z"`` (unauthored: USD's fallback, Y).
-
-    Raises:
-        SceneError: any other authored value (``X``, or an invalid token),
-            naming the file, ``upAxis`` and the value.
-    """
-    from pxr import UsdGeom
-
-    if stage.HasAuthoredMetadata("upAxis"):
-        value = str(stage.GetMetadata("upAxis"))
-    else:
-        value = str(UsdGeom.GetFallbackUpAxis())
-    if value not in ("Y", "Z"):
-        raise SceneError(path or stage.GetRootLayer().identifier, "upAxis",
-                         f"unsupported upAxis {value!r}: USD stages must be Y-up or Z-up")
-    return value
-
-
-def stage_meters_per_unit(stage, path: str | os.PathLike | None = None) -> float:
-    """The stage's ``metersPerUnit`` (unauthored: USD's fallback, 0.01).
-
-    Raises:
-        SceneError: the value is not a positive finite number.
-    """
-    from pxr import UsdGeom
-
-    value = float(UsdGeom.GetStageMetersPerUnit(stage))
-    if not math.isfinite(value) or value <= 0:
-        raise SceneError(path or stage.GetRootLayer().identifier, "metersPerUnit",
-                         f"metersPerUnit must be a positive number, got {value!r}")
-    return value
-
-
-_ISAAC_TYPE_RE = re.compile(r"^semantic:(?P<inst>[^:]+):params:semanticType$")
-
-
-def prim_semantic_label(prim) -> str | None:
-    """The class label authored on ``prim`` itself, or None.
-
-    Looked up in this order: ``ignjax:category``; ``UsdSemantics.LabelsAPI``
-    ``semantics:labels:class`` (first non-empty token); Isaac-style
-    ``semantic:<name>:params:semanticType == "class"`` with its
-    ``semanticData`` (the part before a comma when it lists several).
-    """
-    attr = prim.GetAttribute(NS + "category")
-    if attr and attr.HasAuthoredValue():
-        value = attr.Get()
-        if value:
-            return str(value)
-    names = prim.GetAuthoredPropertyNames()
-    for name in names:
-        if name.startswith("semantics:labels:") and name.split(":", 2)[2].lower() == LABELS_TAXONOMY:
-            value = prim.GetAttribute(name).Get()
-            for token in (value or ()):
-                if str(token).strip():
-                    return str(token).strip()
-    for name in names:
-        m = _ISAAC_TYPE_RE.match(name)
-        if not m:
-            continue
-        if str(prim.GetAttribute(name).Get() or "").strip().lower() != LABELS_TAXONOMY:
-            continue
-        data = prim.GetAttribute(f"semantic:{m.group('inst')}:params:semanticData")
-        value = str(data.Get() or "").split(",")[0].strip() if data else ""
-        if value:
-            return value
-    return None
-
-
-def _newell_normal(p: np.ndarray) -> np.ndarray:
-    # Shape: p (n, 3) -> (3,)
-    q = np.roll(p, -1, axis=0)
-    return np.array([
-        np.sum((p[:, 1] - q[:, 1]) * (p[:, 2] + q[:, 2])),
-        np.sum((p[:, 2] - q[:, 2]) * (p[:, 0] + q[:, 0])),
-        np.sum((p[:, 0] - q[:, 0]) * (p[:, 1] + q[:, 1])),
-    ])
-
-
-def _earclip_face(points: np.ndarray, ring: np.ndarray) -> list[tuple[int, int, int]]:
-    """Triangulate one polygon face (indices ``ring`` into ``points``)."""
-    import mapbox_earcut
-
-    p = points[ring]
-    n = _newell_normal(p)
-    norm = float(np.linalg.norm(n))
-    if norm < 1e-300:
-        return []
-    n = n / norm
-    # An orthonormal basis (u, v, n), right-handed, so that a face wound
-    # counter-clockwise about its normal is counter-clockwise in (u, v).
-    helper = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    u = np.cross(helper, n)
-    u /= np.linalg.norm(u)
-    v = np.cross(n, u)
-    d = p - p[0]
-    xy = np.stack([d @ u, d @ v], axis=1)
-    tri = np.asarray(mapbox_earcut.triangulate_float64(xy, np.array([len(ring)], dtype=np.uint32)), dtype=np.int64)
-    tri = tri.reshape(-1, 3)
-    out = []
-    for a, b, c in tri:
-        area2 = (xy[b, 0] - xy[a, 0]) * (xy[c, 1] - xy[a, 1]) - (xy[b, 1] - xy[a, 1]) * (xy[c, 0] - xy[a, 0])
-        if area2 < 0:
-            b, c = c, b
-        out.append((int(ring[a]), int(ring[b]), int(ring[c])))
-    return out
-
-
-def triangulate_faces(points, counts, indices, *, left_handed: bool = False,
-                      holes: Iterable[int] = (), path=None, where: str | None = None) -> np.ndarray:
-    """Triangulate USD polygon faces, concave ones included.
-
-    Triangles pass through; quads are split along the diagonal that lies
-    inside the face; faces with more vertices are projected onto their
-    best-fit (Newell) plane and ear-clipped. Triangles keep the face's
-    winding; ``left_handed`` flips it so the result is right-handed.
-    Faces with fewer than three vertices and faces listed in ``holes``
-    (USD ``holeIndices``) are dropped.
-
-    Args:
-        points: (V, 3) vertex positions.
-        counts: (F,) ``faceVertexCounts``.
-        indices: (sum(counts),) ``faceVertexIndices``.
-
-    Returns:
-        (T, 3) int64 vertex indices.
-
-    Raises:
-        SceneError: counts and indices disagree, or an index is out of range.
-    """
-    pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    counts = np.asarray(counts, dtype=np.int64).reshape(-1)
-    idx = np.asarray(indices, dtype=np.int64).reshape(-1)
-    if counts.size and counts.min() < 0:
-        raise SceneError(path, where, "faceVertexCounts has negative entries")
-    if int(counts.sum()) != idx.size:
-        raise SceneError(path, where, f"faceVertexCounts sum to {int(counts.sum())} but there are {idx.size} faceVertexIndices")
-    if idx.size and (idx.min() < 0 or idx.max() >= len(pts)):
-        raise SceneError(path, where, f"faceVertexIndices refer to vertex {int(idx.max()) if idx.max() >= len(pts) else int(idx.min())} "
-                                      f"but there are {len(pts)} points")
-    starts = np.concatenate([[0], np.cumsum(counts)[:-1]]) if counts.size else np.zeros(0, np.int64)
-    keep = np.ones(len(counts), dtype=bool)
-    hole_list = [h for h in holes if 0 <= h < len(counts)]
-    keep[hole_list] = False
-    parts: list[np.ndarray] = []
-    # Shape: (n3, 3)
-    sel = keep & (counts == 3)
-    if sel.any():
-        s = starts[sel]
-        parts.append(np.stack([idx[s], idx[s + 1], idx[s + 2]], axis=1))
-    sel = keep & (counts == 4)
-    if sel.any():
-        s = starts[sel]
-        q = np.stack([idx[s + k] for k in range(4)], axis=1)  # Shape: (n4, 4)
-        P = pts[q]  # Shape: (n4, 4, 3)
-        nq = _newell_batch(P)
-        c1 = np.einsum("ij,ij->i", np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]), nq)
-        c2 = np.einsum("ij,ij->i", np.cross(P[:, 2] - P[:, 0], P[:, 3] - P[:, 0]), nq)
-        ok = (c1 >= 0) & (c2 >= 0)
-        a = np.where(ok[:, None], q[:, [0, 1, 2]], q[:, [1, 2, 3]])
-        b = np.where(ok[:, None], q[:, [0, 2, 3]], q[:, [1, 3, 0]])
-        parts += [a, b]
-    big = np.nonzero(keep & (counts > 4))[0]
-    if big.size:
-        tris: list[tuple[int, int, int]] = []
-        for f in big:
-            ring = idx[starts[f]:starts[f] + counts[f]]
-            tris += _earclip_face(pts, ring)
-        if tris:
-            parts.append(np.asarray(tris, dtype=np.int64))
-    if not parts:
-        return np.zeros((0, 3), dtype=np.int64)
-    out = np.concatenate(parts).astype(np.int64)
-    if left_handed:
-        out = out[:, [0, 2, 1]]
-    return out
-
-
-def _newell_batch(P: np.ndarray) -> np.ndarray:
-    # Shape: P (n, k, 3) -> (n, 3)
-    Q = np.roll(P, -1, axis=1)
-    return np.stack([
-        np.sum((P[..., 1] - Q[..., 1]) * (P[..., 2] + Q[..., 2]), axis=1),
-        np.sum((P[..., 2] - Q[..., 2]) * (P[..., 0] + Q[..., 0]), axis=1),
-        np.sum((P[..., 0] - Q[..., 0]) * (P[..., 1] + Q[..., 1]), axis=1),
-    ], axis=1)
-
-
-# ---------------------------------------------------------------------------
-# Export
-# ---------------------------------------------------------------------------
-
 
 def _unique_name(raw: str, used: set[str]) -> str:
-    from pxr import Tf
-
     base = Tf.MakeValidIdentifier(raw or "_")
     name, k = base, 2
     while name in used:
@@ -330,8 +81,6 @@ def _set(prim, name: str, type_name, value) -> None:
 
 
 def _apply_labels(prim, label: str) -> None:
-    from pxr import Sdf, UsdSemantics
-
     labels = UsdSemantics.LabelsAPI.Apply(prim, LABELS_TAXONOMY)
     labels.CreateLabelsAttr([label])
     # Isaac Sim's (older) SemanticsAPI, applied by name so Isaac tools see it.
@@ -341,30 +90,22 @@ def _apply_labels(prim, label: str) -> None:
 
 
 def _display(gprim, rgba) -> None:
-    from pxr import Gf, UsdGeom
-
     gprim.CreateDisplayColorPrimvar(UsdGeom.Tokens.constant).Set([Gf.Vec3f(*(float(c) for c in rgba[:3]))])
     gprim.CreateDisplayOpacityPrimvar(UsdGeom.Tokens.constant).Set([float(rgba[3])])
 
 
 def _set_extent(gprim) -> None:
-    from pxr import Usd, UsdGeom
-
     ext = UsdGeom.Boundable.ComputeExtentFromPlugins(gprim, Usd.TimeCode.Default())
     if ext is not None:
         gprim.CreateExtentAttr(ext)
 
 
 def _place(xformable, translate, yaw: float) -> None:
-    from pxr import Gf, UsdGeom
-
     xformable.AddTranslateOp(UsdGeom.XformOp.PrecisionDouble).Set(Gf.Vec3d(*translate))
     xformable.AddRotateZOp(UsdGeom.XformOp.PrecisionDouble).Set(math.degrees(yaw))
 
 
 def _mesh_prim(stage, path, vertices: np.ndarray, faces: np.ndarray, counts=None):
-    from pxr import UsdGeom, Vt
-
     mesh = UsdGeom.Mesh.Define(stage, path)
     mesh.CreatePointsAttr(Vt.Vec3fArray.FromNumpy(np.asarray(vertices, dtype=np.float32)))
     f = np.asarray(faces, dtype=np.int32)
@@ -377,8 +118,6 @@ def _mesh_prim(stage, path, vertices: np.ndarray, faces: np.ndarray, counts=None
 
 
 def _author_geom(stage, parent_path, name: str, g: Geom, index: int):
-    from pxr import Gf, Sdf, UsdGeom, Vt
-
     path = parent_path.AppendChild(name)
     k = g.kind
     if k == "box":
@@ -432,8 +171,6 @@ def _author_geom(stage, parent_path, name: str, g: Geom, index: int):
 
 
 def _author_instance(stage, path, inst: Instance) -> None:
-    from pxr import Gf, Kind, Sdf, Usd, UsdGeom
-
     T = Sdf.ValueTypeNames
     xf = UsdGeom.Xform.Define(stage, path)
     Usd.ModelAPI(xf.GetPrim()).SetKind(Kind.Tokens.component)
@@ -476,8 +213,6 @@ def _author_instance(stage, path, inst: Instance) -> None:
 
 
 def _author_room(stage, path, room: Room) -> None:
-    from pxr import Gf, Sdf, UsdGeom, Vt
-
     T = Sdf.ValueTypeNames
     xf = UsdGeom.Xform.Define(stage, path)
     p = xf.GetPrim()
@@ -496,8 +231,6 @@ def _author_room(stage, path, room: Room) -> None:
 
 
 def _author_wall(stage, path, wall: Wall) -> None:
-    from pxr import Gf, Sdf, UsdGeom
-
     T = Sdf.ValueTypeNames
     xf = UsdGeom.Xform.Define(stage, path)
     (x0, y0), (x1, y1) = wall.start, wall.end
@@ -521,8 +254,6 @@ def _author_wall(stage, path, wall: Wall) -> None:
 
 
 def _author_door(stage, path, door: Door) -> None:
-    from pxr import Gf, Sdf, UsdGeom
-
     T = Sdf.ValueTypeNames
     xf = UsdGeom.Xform.Define(stage, path)
     _place(xf, (door.position[0], door.position[1], 0.0), door.yaw)
@@ -547,8 +278,6 @@ def _author_door(stage, path, door: Door) -> None:
 def scene_to_stage(scene: Scene):
     """Author ``scene`` into a new in-memory stage (see the module docstring
     for the layout) and return the stage."""
-    from pxr import Kind, Sdf, Usd, UsdGeom
-
     stage = Usd.Stage.CreateInMemory()
     UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.z)
     UsdGeom.SetStageMetersPerUnit(stage, 1.0)
@@ -611,8 +340,6 @@ def save_usd(scene: Scene, path: str | os.PathLike) -> Path:
         raise SceneError(out, None, f"cannot write: {e}") from e
     try:
         if suffix == ".usdz":
-            from pxr import UsdUtils
-
             inner = tmpdir / (out.stem + ".usdc")
             if not stage.GetRootLayer().Export(str(inner)):
                 raise SceneError(out, None, "USD could not write the layer")
@@ -629,42 +356,3 @@ def save_usd(scene: Scene, path: str | os.PathLike) -> Path:
     finally:
         shutil.rmtree(tmpdir, ignore_errors=True)
     return out
-
-
-# ---------------------------------------------------------------------------
-# Import entry point
-# ---------------------------------------------------------------------------
-
-
-def load_usd(path: str | os.PathLike, *, scene_id: str | None = None, correct_layer_units: bool = True) -> Scene:
-    """Read any USD stage into a :class:`Scene` (Z-up, metres).
-
-    Stages written by :func:`save_usd` come back without loss; any other
-    stage is converted by the rules in :mod:`ignjax.scenes.io.usd_import`
-    (which prims are objects, their categories, rooms, units).
-
-    Args:
-        path: a ``.usd``/``.usda``/``.usdc``/``.usdz`` file.
-        scene_id: the scene's id; default: the id stored by :func:`save_usd`,
-            else the file stem.
-        correct_layer_units: rescale geometry and translations that come from
-            layers whose own ``metersPerUnit`` differs from the stage's
-            (plain USD ignores such layer metadata; see
-            :mod:`ignjax.scenes.io.usd_import`).
-
-    Returns:
-        A validated scene; ``meta.up_axis`` and ``meta.meters_per_unit``
-        record the stage's original up axis and unit.
-
-    Raises:
-        SceneError: not a USD file, unsupported ``upAxis``, no geometry,
-            NaN/inf transforms or points, malformed meshes, or a scene that
-            fails :func:`~ignjax.scenes.model.validate_scene`.
-
-    Warns:
-        UsdImportWarning: missing sublayers/references/payloads (the rest is
-            imported), an invalid ``defaultPrim``, skipped prims.
-    """
-    from ignjax.scenes.io.usd_import import import_stage
-
-    return import_stage(path, scene_id=scene_id, correct_layer_units=correct_layer_units)
