@@ -13,10 +13,11 @@ from __future__ import annotations
 import jax
 import numpy as np
 
-from ignjax.agents.base import Agent, get_agent
+from ignjax.agents import Agent, get_agent
 from ignjax.episodes.dataset import EpisodeSet
 from ignjax.sim.rollout import episode_keys, pad_batch, rollout
-from ignjax.sim.env import World, check_specs
+from ignjax.sim.env import check_specs
+from ignjax.sim.world import World
 from ignjax.sim.types import SimConfig
 
 

@@ -1,8 +1,9 @@
 """The oracle's words: array facts -> short natural-language answers (host side).
 
-The simulator computes answers as arrays (:class:`ignjax.sim.types.Answer`);
-agents that read language (MLLM agents, logs, reports) get them rendered
-here. The templates are our own wording; they follow the paper's rules:
+The simulator computes answers as arrays (:class:`ignjax.sim.types.Answer`,
+by :mod:`ignjax.sim.oracle`); agents that read language (MLLM agents, logs,
+reports) get them rendered here. The templates are our own wording; they
+follow the paper's rules:
 
 * Type 1 (appearance) repeats the episode's target description, which
   never names a room.

@@ -9,24 +9,27 @@ rows); :func:`rollout` jits it once per (agent, piece shape), and
 :func:`rollout_sweep` runs K agent parameter settings x E episodes as one
 batch of K E rows (e.g. K cost vectors in one call). Both run a batch as
 concurrent pieces on CPU (:func:`batch_parts`), since XLA:CPU gives the
-body of a scan one core.
+body of a scan one core. The pieces share one compiled program (kept in a
+bounded, locked cache of :data:`MAX_EXECUTABLES` programs) and one
+process-wide pool of :data:`POOL_WORKERS` threads, made once under a lock.
 
-Agents are pure functions (:class:`ignjax.agents.base.Agent`): ``init`` and
+Agents are pure functions (:class:`ignjax.agents.Agent`): ``init`` and
 ``act`` see the :class:`~ignjax.sim.types.Observation` and the oracle's
 :class:`~ignjax.sim.types.Answer` only; privileged agents (labelled as such)
-also receive :class:`Privileged` information.
+also receive :class:`~ignjax.sim.types.Privileged` information
+(:func:`ignjax.sim.env.privileged_info`).
 
 Besides the outcome row, a rollout records a compact trajectory per episode
-(pose after every step, action kind and question type), used for
-trajectory plots and the interaction analyses.
+(:class:`~ignjax.sim.types.Trajectory`: pose after every step, action kind
+and question type), used for trajectory plots and the interaction analyses.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import threading
+from collections import OrderedDict
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
 from functools import partial
 
 import jax
@@ -35,69 +38,17 @@ import jax.numpy as jnp
 from ignjax.sim import env as E
 from ignjax.sim import types as T
 from ignjax.sim.compact import chunk_size, even_chunk, first_equal, masked_map
+from ignjax.sim.world import World
 
 
-@partial(jax.tree_util.register_dataclass, data_fields=["geodesic", "best_direction", "best_col", "best_row", "best_value"],
-         meta_fields=[])
-@dataclass(frozen=True)
-class Privileged:
-    """Information only privileged agents receive.
-
-    Attributes:
-        geodesic: () float32 geodesic distance to the target now.
-        best_direction, best_col, best_row: () int32 the MOVE whose executor
-            waypoint is geodesically closest to the target, among views
-            0..7 x columns {3, 4, 5, 6} x rows {1, 2, 3}.
-        best_value: () float32 geodesic distance at that waypoint.
-    """
-
-    geodesic: jax.Array
-    best_direction: jax.Array
-    best_col: jax.Array
-    best_row: jax.Array
-    best_value: jax.Array
-
-
-def privileged_info(world: E.World, state: T.SimState) -> Privileged:
-    """Planning information for privileged agents (never for others): the
-    executor's waypoint of every candidate cell, scored by the target's
-    geodesic field."""
-    ep = state.episode
-    views, cols, rows = jnp.meshgrid(jnp.arange(8), jnp.array([3, 4, 5, 6]), jnp.array([1, 2, 3]), indexing="ij")
-    views, cols, rows = views.reshape(-1), cols.reshape(-1), rows.reshape(-1)
-    wps = jax.vmap(lambda d, c, r: E.pixel_waypoint(world, ep.scene, state.pose, d, c, r)[0])(views, cols, rows)
-    vals = jax.vmap(lambda xy: E.geodesic_to_target(world, ep, xy))(wps)
-    moved = jnp.linalg.norm(wps - state.pose[None, :2], axis=1)
-    vals = jnp.where(moved > 0.2, vals, jnp.inf)  # a cell that goes nowhere is no plan
-    k = jnp.argmin(vals)
-    return Privileged(geodesic=E.geodesic_to_target(world, ep, state.pose[:2]), best_direction=views[k].astype(jnp.int32),
-                      best_col=cols[k].astype(jnp.int32), best_row=rows[k].astype(jnp.int32), best_value=vals[k])
-
-
-@partial(jax.tree_util.register_dataclass, data_fields=["pose", "kind", "question"], meta_fields=[])
-@dataclass(frozen=True)
-class Trajectory:
-    """Per-step record of one episode.
-
-    Attributes:
-        pose: (S + 1, 3) float32 pose before the first step and after each step.
-        kind: (S,) int32 action kind of each step (-1 after the episode ended).
-        question: (S,) int32 question type of ASK steps, 0 otherwise.
-    """
-
-    pose: jax.Array
-    kind: jax.Array
-    question: jax.Array
-
-
-def rollout_episode(world: E.World, spec: T.EpisodeSpec, agent, params, key: jax.Array):
+def rollout_episode(world: World, spec: T.EpisodeSpec, agent, params, key: jax.Array):
     """Run one episode to the end. Returns (OutcomeRow, Trajectory, final SimState)."""
     cfg = world.config
     state = E.reset(world, spec)
     obs = E.observe(world, state)
     key, k0 = jax.random.split(key)
     pstate = agent.init(params, obs, k0)
-    priv0 = privileged_info(world, state) if agent.privileged else None
+    priv0 = E.privileged_info(world, state) if agent.privileged else None
 
     def body(carry, k):
         state, obs, pstate, priv = carry
@@ -105,14 +56,14 @@ def rollout_episode(world: E.World, spec: T.EpisodeSpec, agent, params, key: jax
         was_done = state.done
         state = E.step(world, state, action)
         obs = E.observe(world, state)
-        priv = privileged_info(world, state) if agent.privileged else None
+        priv = E.privileged_info(world, state) if agent.privileged else None
         kind = jnp.where(was_done, -1, jnp.clip(action.kind, 0, 2))
         q = jnp.where((kind == T.ASK), jnp.clip(action.question, 1, 4), 0)
         return (state, obs, pstate, priv), (state.pose, kind.astype(jnp.int32), q.astype(jnp.int32))
 
     keys = jax.random.split(key, cfg.max_steps)
     (state, _, _, _), (poses, kinds, qs) = jax.lax.scan(body, (state, obs, pstate, priv0), keys)
-    traj = Trajectory(pose=jnp.concatenate([spec.start[None].astype(jnp.float32), poses]), kind=kinds, question=qs)
+    traj = T.Trajectory(pose=jnp.concatenate([spec.start[None].astype(jnp.float32), poses]), kind=kinds, question=qs)
     return E.outcome(world, state), traj, state
 
 
@@ -158,9 +109,42 @@ def batch_parts(n_rows: int, parts: int | None = None) -> int:
     return max(1, min(int(parts), int(n_rows)))
 
 
-_EXECUTABLES: dict = {}
-_EXECUTABLES_LOCK = threading.Lock()
-_POOL: list = []
+MAX_EXECUTABLES = 64
+"""Compiled rollout programs kept for the pieces (the least recently used is dropped first)."""
+POOL_WORKERS = 32
+"""Threads that run a batch's pieces (made as needed; pieces beyond them wait for a free one)."""
+
+
+class _ExecutableCache:
+    """Compiled programs by key, at most ``maxsize`` of them (least recently
+    used dropped first); thread-safe, and a program is compiled once however
+    many threads ask for it at the same time."""
+
+    def __init__(self, maxsize: int):
+        self.maxsize = int(maxsize)
+        self._items: OrderedDict = OrderedDict()
+        self._lock = threading.Lock()
+
+    def __len__(self) -> int:
+        with self._lock:
+            return len(self._items)
+
+    def get(self, key, compile_fn):
+        """The program under ``key``, compiled by ``compile_fn()`` (under the lock) when absent."""
+        with self._lock:
+            exe = self._items.get(key)
+            if exe is None:
+                exe = self._items[key] = compile_fn()
+                while len(self._items) > self.maxsize:
+                    self._items.popitem(last=False)
+            else:
+                self._items.move_to_end(key)
+            return exe
+
+
+_EXECUTABLES = _ExecutableCache(MAX_EXECUTABLES)
+_POOL: ThreadPoolExecutor | None = None
+_POOL_LOCK = threading.Lock()
 
 
 def _executable(jitted, dynamic: tuple, static: dict):
@@ -168,20 +152,17 @@ def _executable(jitted, dynamic: tuple, static: dict):
     pieces started together do not each compile it)."""
     leaves, tree = jax.tree.flatten(dynamic)
     key = (jitted, tuple(sorted(static.items())), tree, tuple(jax.typeof(x) for x in leaves))
-    with _EXECUTABLES_LOCK:
-        exe = _EXECUTABLES.get(key)
-        if exe is None:
-            exe = _EXECUTABLES[key] = jitted.lower(*dynamic[:2], static["agent"], *dynamic[2:],
-                                                    chunk=static["chunk"]).compile()
-    return exe
+    return _EXECUTABLES.get(key, lambda: jitted.lower(*dynamic[:2], static["agent"], *dynamic[2:],
+                                                      chunk=static["chunk"]).compile())
 
 
-def _pool(n: int) -> ThreadPoolExecutor:
-    if not _POOL or _POOL[0]._max_workers < n:
-        if _POOL:
-            _POOL[0].shutdown(wait=False)
-        _POOL[:] = [ThreadPoolExecutor(n, thread_name_prefix="ignjax-rollout")]
-    return _POOL[0]
+def _pool() -> ThreadPoolExecutor:
+    """The process's one pool of :data:`POOL_WORKERS` threads for pieces, made on first use."""
+    global _POOL
+    with _POOL_LOCK:
+        if _POOL is None:
+            _POOL = ThreadPoolExecutor(POOL_WORKERS, thread_name_prefix="ignjax-rollout")
+        return _POOL
 
 
 def _in_parts(jitted, world, specs, agent, params, keys, chunk, parts: int, out_axis: int):
@@ -197,7 +178,7 @@ def _in_parts(jitted, world, specs, agent, params, keys, chunk, parts: int, out_
     pieces = [(world, jax.tree.map(lambda a: a[i * size:(i + 1) * size], specs), params, keys[i * size:(i + 1) * size])
               for i in range(parts)]
     exe = _executable(jitted, pieces[0], {"agent": agent, "chunk": chunk})
-    futures = [_pool(parts).submit(lambda p: jax.block_until_ready(exe(*p)), p) for p in pieces]
+    futures = [_pool().submit(lambda p: jax.block_until_ready(exe(*p)), p) for p in pieces]
     outs = [f.result() for f in futures]
     return jax.tree.map(lambda *xs: jax.lax.slice_in_dim(jnp.concatenate(xs, out_axis), 0, n, axis=out_axis), *outs)
 
@@ -213,7 +194,7 @@ def _keys(key: jax.Array, n: int) -> jax.Array:
     return key if key.shape == (n,) else jax.random.split(key, n)
 
 
-def rollout_rows(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.Array, chunk: int | None = None,
+def rollout_rows(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.Array, chunk: int | None = None,
                  groups: jax.Array | None = None, group_chunk: int | None = None):
     """Run a batch of episodes (leading axis B) with per-row agent parameters.
 
@@ -251,7 +232,7 @@ def rollout_rows(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.
     split = jax.vmap(jax.random.split)(keys)
     pstate = jax.vmap(agent.init)(params, obs, split[:, 1])
     step_keys = jnp.swapaxes(jax.vmap(lambda k: jax.random.split(k, cfg.max_steps))(split[:, 0]), 0, 1)
-    privileged = (lambda st: privileged_info(world, st)) if agent.privileged else None
+    privileged = (lambda st: E.privileged_info(world, st)) if agent.privileged else None
     priv0 = jax.vmap(privileged)(state) if privileged else None
     act = lambda x: agent.act(*x)  # noqa: E731
     act_chunk = even_chunk(keys.shape[0], chunk or chunk_size(keys.shape[0]))
@@ -286,20 +267,20 @@ def rollout_rows(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.
     groups = None if groups is None else jnp.asarray(groups, jnp.int32)
     group_chunk = chunk if group_chunk is None else group_chunk
     (state, _, _, _, _), (poses, kinds, qs) = jax.lax.scan(body, (state, obs, pstate, priv0, groups), step_keys)
-    traj = Trajectory(pose=jnp.concatenate([specs.start[:, None].astype(jnp.float32), jnp.swapaxes(poses, 0, 1)], 1),
+    traj = T.Trajectory(pose=jnp.concatenate([specs.start[:, None].astype(jnp.float32), jnp.swapaxes(poses, 0, 1)], 1),
                       kind=kinds.T, question=qs.T)
     return jax.vmap(lambda st: E.outcome(world, st))(state), traj, state
 
 
 @partial(jax.jit, static_argnames=("agent", "chunk"), compiler_options=ROLLOUT_COMPILER_OPTIONS)
-def _rollout(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.Array, chunk: int | None = None):
+def _rollout(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.Array, chunk: int | None = None):
     n = specs.scene.shape[0]
     rows = jax.tree.map(lambda x: jnp.broadcast_to(x, (n,) + jnp.shape(x)), params)
     return rollout_rows(world, specs, agent, rows, keys, chunk)[:2]
 
 
 @partial(jax.jit, static_argnames=("agent", "chunk"), compiler_options=ROLLOUT_COMPILER_OPTIONS)
-def _rollout_sweep(world: E.World, specs: T.EpisodeSpec, agent, params_batch, keys: jax.Array,
+def _rollout_sweep(world: World, specs: T.EpisodeSpec, agent, params_batch, keys: jax.Array,
                    chunk: int | None = None):
     n = specs.scene.shape[0]
     K = jax.tree.leaves(params_batch)[0].shape[0]
@@ -311,7 +292,7 @@ def _rollout_sweep(world: E.World, specs: T.EpisodeSpec, agent, params_batch, ke
     return jax.tree.map(lambda a: a.reshape((K, n) + a.shape[1:]), out)
 
 
-def rollout(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.Array, chunk: int | None = None,
+def rollout(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.Array, chunk: int | None = None,
             parts: int | None = None):
     """Run a batch of episodes (leading axis E of ``specs``) with one agent.
 
@@ -332,7 +313,7 @@ def rollout(world: E.World, specs: T.EpisodeSpec, agent, params, keys: jax.Array
     return _in_parts(_rollout, world, specs, agent, params, keys, chunk, batch_parts(n, parts), 0)
 
 
-def rollout_sweep(world: E.World, specs: T.EpisodeSpec, agent, params_batch, keys: jax.Array, chunk: int | None = None,
+def rollout_sweep(world: World, specs: T.EpisodeSpec, agent, params_batch, keys: jax.Array, chunk: int | None = None,
                   parts: int | None = None):
     """Run every episode under every parameter setting (leading axis K of
     ``params_batch``): K x E episodes in one call, as one batch of K E rows,

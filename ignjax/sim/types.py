@@ -2,8 +2,10 @@
 
 Every array field documents its shape and dtype for ONE episode; under
 ``vmap`` a leading batch axis is added. All pytrees are frozen dataclasses
-registered with ``jax.tree_util.register_dataclass`` (static fields listed
-in ``meta_fields``); change them with :func:`dataclasses.replace`.
+registered by :func:`ignjax.arrays.pytree_dataclass`; change them with
+:func:`dataclasses.replace`. The rollout's records (:class:`OutcomeRow`,
+:class:`Trajectory`) and what privileged agents receive (:class:`Privileged`)
+live here too.
 
 Codes
     Action kinds: ``MOVE = 0``, ``ASK = 1``, ``STOP = 2``.
@@ -17,15 +19,15 @@ Codes
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
-from functools import partial
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ignjax import protocol
+from ignjax.arrays import pytree_dataclass
 from ignjax.errors import ConfigError
 
 MOVE, ASK, STOP = 0, 1, 2
@@ -35,14 +37,8 @@ STOP_REASONS = ("running", "stop", "step_budget")
 HINT_NONE, HINT_CLOSER, HINT_SAME, HINT_FARTHER, HINT_REACHED, HINT_STOP = 0, 1, 2, 3, 4, 5
 HINT_PROGRESS = ("none", "closer", "no_change", "farther", "reached", "stop_eligible")
 FOLLOW_NONE, FOLLOW_STOP_NOW, FOLLOW_ONE_MOVE = 0, 1, 2
-N_VIEWS = 8
-N_QTYPES = 4
-
-
-def _static(cls):
-    """Register a frozen dataclass whose fields are all pytree children."""
-    names = [f.name for f in dataclasses.fields(cls)]
-    return partial(jax.tree_util.register_dataclass, data_fields=names, meta_fields=[])(cls)
+N_VIEWS = protocol.N_VIEWS
+N_QTYPES = protocol.N_QUESTION_TYPES
 
 
 @dataclass(frozen=True)
@@ -73,10 +69,10 @@ class SimConfig:
         trace_len: question-trace slots (attempts, charged or refused).
     """
 
-    max_steps: int = 20
-    max_questions: int = 10
+    max_steps: int = protocol.MAX_STEPS
+    max_questions: int = protocol.MAX_QUESTIONS
     horizon: float = 3.0
-    collision_distance: float = 0.6
+    collision_distance: float = protocol.COLLISION_DISTANCE
     collision_heights: tuple[float, ...] = (0.15, 0.6, 1.2)
     micro_step: float = 0.5
     max_micro_steps: int = 8
@@ -86,8 +82,8 @@ class SimConfig:
     depth_range: float = 10.0
     pullback: float = 0.3
     waypoint_tolerance: float = 0.1
-    hint_lookahead: float = 4.0
-    confirm_range: float = 3.0
+    hint_lookahead: float = protocol.HINT_LOOKAHEAD
+    confirm_range: float = protocol.CONFIRM_RANGE
     stop_radius: float = 1.0
     hint_reached: float = 1.0
     obs_rays_per_view: int = 3
@@ -113,8 +109,7 @@ class SimConfig:
         object.__setattr__(self, "image_size", tuple(int(v) for v in self.image_size))
 
 
-@_static
-@dataclass(frozen=True)
+@pytree_dataclass
 class Action:
     """One decision (int32 scalars; out-of-range values are clamped inside a
     rollout and counted as invalid; :func:`ignjax.sim.env.check_action`
@@ -143,8 +138,7 @@ class Action:
         return Action(i(kind), i(direction), i(col), i(row), i(question), i(candidate))
 
 
-@_static
-@dataclass(frozen=True)
+@pytree_dataclass
 class Answer:
     """What the oracle has said so far, as array facts (the latest answer of
     each type; text is rendered on the host by :mod:`ignjax.sim.oracle_text`).
@@ -202,8 +196,7 @@ class Answer:
                       hint_progress=jnp.int32(HINT_NONE), confirm=m1, follow_up=jnp.int32(FOLLOW_NONE))
 
 
-@_static
-@dataclass(frozen=True)
+@pytree_dataclass
 class Observation:
     """What a policy may see (never the target's identity, pose or distance).
 
@@ -250,8 +243,7 @@ class Observation:
     last_move: jax.Array
 
 
-@_static
-@dataclass(frozen=True)
+@pytree_dataclass
 class EpisodeSpec:
     """The fixed facts of one episode, carried in the state (never observed
     directly; the oracle reads them).
@@ -285,8 +277,7 @@ class EpisodeSpec:
     valid: jax.Array
 
 
-@_static
-@dataclass(frozen=True)
+@pytree_dataclass
 class SimState:
     """The state of one episode.
 
@@ -333,6 +324,77 @@ class SimState:
     answers: Answer
 
 
+@pytree_dataclass
+class OutcomeRow:
+    """One episode's outcome (arrays; a leading batch axis under vmap).
+
+    Attributes:
+        final_distance: () float32 geodesic distance to the target at the end.
+        final_euclidean: () float32 2-D distance to the target footprint.
+        min_distance: () float32 smallest geodesic distance along the path.
+        path_length: () float32 metres travelled.
+        steps: () int32 planner steps used.
+        stopped: () bool, ended by STOP.
+        stop_reason: () int32 (see the module docstring).
+        n_questions: (4,) int32 charged questions per type.
+        n_refused: () int32 refused questions.
+        n_invalid: () int32 clamped out-of-range actions.
+        trace_type, trace_step, trace_charged: (T,) the question trace.
+        difficulty: () int32 bin.
+        valid: () bool.
+    """
+
+    final_distance: jax.Array
+    final_euclidean: jax.Array
+    min_distance: jax.Array
+    path_length: jax.Array
+    steps: jax.Array
+    stopped: jax.Array
+    stop_reason: jax.Array
+    n_questions: jax.Array
+    n_refused: jax.Array
+    n_invalid: jax.Array
+    trace_type: jax.Array
+    trace_step: jax.Array
+    trace_charged: jax.Array
+    difficulty: jax.Array
+    valid: jax.Array
+
+
+@pytree_dataclass
+class Trajectory:
+    """Per-step record of one episode.
+
+    Attributes:
+        pose: (S + 1, 3) float32 pose before the first step and after each step.
+        kind: (S,) int32 action kind of each step (-1 after the episode ended).
+        question: (S,) int32 question type of ASK steps, 0 otherwise.
+    """
+
+    pose: jax.Array
+    kind: jax.Array
+    question: jax.Array
+
+
+@pytree_dataclass
+class Privileged:
+    """Information only privileged agents receive (:func:`ignjax.sim.env.privileged_info`).
+
+    Attributes:
+        geodesic: () float32 geodesic distance to the target now.
+        best_direction, best_col, best_row: () int32 the MOVE whose executor
+            waypoint is geodesically closest to the target, among views
+            0..7 x columns {3, 4, 5, 6} x rows {1, 2, 3}.
+        best_value: () float32 geodesic distance at that waypoint.
+    """
+
+    geodesic: jax.Array
+    best_direction: jax.Array
+    best_col: jax.Array
+    best_row: jax.Array
+    best_value: jax.Array
+
+
 def tree_select(pred, on_true, on_false):
     """Elementwise ``where`` over two pytrees of the same structure; ``pred``
     selects along the leading axes (a () pred a whole tree, a (B,) pred rows
@@ -345,3 +407,14 @@ def tree_select(pred, on_true, on_false):
 def numpy_tree(tree):
     """A pytree of device arrays as numpy arrays (host copy)."""
     return jax.tree.map(lambda a: np.asarray(a), tree)
+
+
+
+def batch_of_one(tree):
+    """A pytree with a leading batch axis of size 1 added to every leaf."""
+    return jax.tree.map(lambda x: x[None], tree)
+
+
+def only_row(tree):
+    """Row 0 of a pytree with a leading batch axis (the inverse of :func:`batch_of_one`)."""
+    return jax.tree.map(lambda x: x[0], tree)

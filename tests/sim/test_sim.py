@@ -12,13 +12,17 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from ignjax.agents.base import get_agent
+from ignjax.agents import get_agent
 from ignjax.errors import ConfigError
-from ignjax.sim.rollout import rollout, rollout_episode
 from ignjax.sim import env as E
+from ignjax.sim import executor as X
+from ignjax.sim import oracle as O
 from ignjax.sim import oracle_text as OT
-from ignjax.sim.rays import queries as SR
+from ignjax.sim import queries as Q
 from ignjax.sim import types as T
+from ignjax.sim import world as W
+from ignjax.sim.rays import queries as SR
+from ignjax.sim.rollout import rollout, rollout_episode
 
 
 def _spec(es, k):
@@ -80,7 +84,7 @@ def _pose_facing_obstacle(small_benchmark, small_world, lo=0.25, hi=0.55):
     grid = es.bank.navgrids[0]
     pts = grid.navigable_points()
     rng = np.random.default_rng(0)
-    ff = jax.jit(lambda xy, h: E.forward_free(small_world, jnp.int32(0), xy, h))
+    ff = jax.jit(lambda xy, h: X.forward_free(small_world, jnp.int32(0), xy, h))
     for i in rng.permutation(len(pts))[:400]:
         for h in np.arange(8) * math.pi / 4:
             d = float(ff(jnp.asarray(pts[i], jnp.float32), jnp.float32(h)))
@@ -116,12 +120,12 @@ def test_packed_observation_map_equals_probe_map(small_world):
     n_col = len(w.config.collision_heights)
     rng = np.random.default_rng(4)
     for s in range(len(w.bank.scene_ids)):
-        H, W = (int(v) for v in np.asarray(g.shape[s]))
+        n_rows, n_cols = (int(v) for v in np.asarray(g.shape[s]))
         o = np.asarray(g.origin[s])
-        xy = o + rng.uniform(-0.5, 1.0, (20000, 2)) * np.array([W, H]) * g.resolution * 1.2
+        xy = o + rng.uniform(-0.5, 1.0, (20000, 2)) * np.array([n_cols, n_rows]) * g.resolution * 1.2
         xy = jnp.asarray(xy, jnp.float32)
-        fine = np.asarray(E.fine_at(w, jnp.int32(s), xy))
-        packed = np.asarray(E.packed_at(w, w.packed_obs, 2, jnp.int32(s), xy))
+        fine = np.asarray(W.fine_at(w, jnp.int32(s), xy))
+        packed = np.asarray(W.packed_at(w, w.packed_obs, 2, jnp.int32(s), xy))
         assert np.array_equal((fine >> n_col) & 3, packed)
         assert ((fine >> n_col) & 3).any()  # the check saw occupied cells
 
@@ -140,16 +144,16 @@ def test_forward_rays_agree_with_mujoco_at_collision_heights(small_benchmark, sm
     thin leg or a grazed wall), and at most 0.5% run past a surface (corner
     grazes thinner than a fine cell).
     """
-    from ignjax.sim.rays.caster import mj_rays
+    from ignjax.sim.rays.exact import mj_rays
 
     es = small_benchmark["set"]
     bank = es.bank
     rays = bank.rays
-    step = bank.grid.resolution / E.FINE
+    step = bank.grid.resolution / W.FINE
     rng_m = rng_m or small_world.config.collision_distance + bank.grid.resolution
     rng = np.random.default_rng(1)
     n_h = len(small_world.config.collision_heights)
-    f = jax.jit(jax.vmap(lambda w, xy, hd, z: jnp.stack([E.probe_free(w, jnp.int32(0), xy, hd, 1 << j, rng_m, step)
+    f = jax.jit(jax.vmap(lambda w, xy, hd, z: jnp.stack([W.probe_free(w, jnp.int32(0), xy, hd, 1 << j, rng_m, step)
                                                           for j in range(n_h)])[z], in_axes=(None, 0, 0, 0)))
     grid = bank.navgrids[0]
     n = 4000
@@ -189,7 +193,7 @@ def test_forward_rays_agree_with_mujoco_at_collision_heights(small_benchmark, sm
 def test_depth_rays_agree_with_mujoco(small_benchmark, small_world):
     """The executor's pixel-depth ray (voxel traversal + exact primitive tests) agrees
     with mj_ray within one grid cell on >= 99.5% of random rays from eye height."""
-    from ignjax.sim.rays.caster import mj_rays
+    from ignjax.sim.rays.exact import mj_rays
 
     bank = small_benchmark["set"].bank
     rng = np.random.default_rng(3)
@@ -202,8 +206,8 @@ def test_depth_rays_agree_with_mujoco(small_benchmark, small_world):
     u /= np.linalg.norm(u, axis=1, keepdims=True)
     rng_m = 4.0
     f = jax.jit(jax.vmap(lambda r, p, v: SR.march(r, jnp.int32(1), p, v, jnp.float32(rng_m), static_range=rng_m,
-                                                   outside_hits=False, exact=E.DEPTH_EXACT_PRIMS,
-                                                   iterations=E.DEPTH_ITERATIONS), in_axes=(None, 0, 0)))
+                                                   outside_hits=False, exact=X.DEPTH_EXACT_PRIMS,
+                                                   iterations=X.DEPTH_ITERATIONS), in_axes=(None, 0, 0)))
     got = np.asarray(f(bank.rays, jnp.asarray(P, jnp.float32), jnp.asarray(u, jnp.float32)))
     ref, _ = mj_rays(bank.compiled[1], P, u, geomgroup=(1, 1, 1, 1, 0, 0))
     ref = np.where(np.isfinite(ref) & (ref <= rng_m), ref, np.inf)
@@ -216,7 +220,7 @@ def test_depth_rays_agree_with_mujoco(small_benchmark, small_world):
 def test_type3_answers_never_leak_metrics_or_compass(small_benchmark, small_world):
     es = small_benchmark["set"]
     rng = np.random.default_rng(2)
-    facts = jax.jit(jax.vmap(lambda spec, pose: E.route_facts(small_world, spec, pose)[:4]))
+    facts = jax.jit(jax.vmap(lambda spec, pose: O.route_facts(small_world, spec, pose)[:4]))
     texts = []
     for rep in range(60):
         k = rng.integers(len(es), size=len(es))
@@ -253,7 +257,7 @@ def test_type4_yes_only_for_the_target_in_front_within_range(small_benchmark, sm
     for k in range(len(es)):
         spec = _at_reference_view(small_benchmark, k)
         st = fns["reset"](small_world, spec)
-        if not bool(E.target_visible_front(small_world, spec, st.pose)):
+        if not bool(O.target_visible_front(small_world, spec, st.pose)):
             continue  # the reference view sees the target, but the fast march may disagree at a grazing angle
         yes = fns["step"](small_world, st, T.Action.make(T.ASK, question=4, candidate=-1))
         assert int(yes.answers.confirm) == 1
@@ -270,7 +274,7 @@ def test_type4_yes_only_for_the_target_in_front_within_range(small_benchmark, sm
     far = 0
     for k in range(len(es)):
         st = fns["reset"](small_world, _spec(es, k))
-        if float(E.euclidean_to_target(small_world, _spec(es, k), st.pose[:2])) > 3.0:
+        if float(Q.euclidean_to_target(small_world, _spec(es, k), st.pose[:2])) > 3.0:
             assert int(fns["step"](small_world, st, T.Action.make(T.ASK, question=4)).answers.confirm) == 0
             far += 1
     assert far >= 10

@@ -1,0 +1,189 @@
+"""The executor of a MOVE: a view's grid cell -> a waypoint (pixel ray,
+depth, back-projection) -> the local controller's micro-steps with
+collision probes (the MOVE rules of :mod:`ignjax.sim.env`'s docstring).
+
+:func:`execute_moves` runs it for the moving rows of a batch;
+:func:`execute_move` is the same on a batch of one.
+"""
+
+from __future__ import annotations
+
+import math
+
+import jax
+import jax.numpy as jnp
+
+from ignjax.sim import geometry as G
+from ignjax.sim import types as T
+from ignjax.sim.compact import masked_map
+from ignjax.sim.queries import geodesic_to_target, navigable_at, sector_of
+from ignjax.sim.rays import queries as SR
+from ignjax.sim.world import FINE, World, fine_at, probe_free
+
+
+DEPTH_ELEVATION = math.radians(55.0)  # steepest pixel ray followed to the full waypoint range
+DEPTH_EXACT_PRIMS = 8  # primitives tested exactly per occupied voxel by the depth ray
+DEPTH_ITERATIONS = 64  # traversal steps of the depth ray (free space is crossed several voxels at a time)
+
+
+def pixel_waypoint(world: World, s, pose, direction, col, row):
+    """The executor's waypoint for a grid cell of a view (before the controller).
+
+    Returns:
+        (waypoint (2,), hit_obstacle (), used_depth (), used_floor ()).
+    """
+    cfg = world.config
+    W, H = cfg.image_size
+    K = G.intrinsics(float(W), float(H), math.radians(cfg.hfov))
+    yaw = pose[2] + direction.astype(jnp.float32) * (math.pi / 4)
+    uv = G.grid_to_pixel(col, row, float(W), float(H))
+    d_c = G.pixel_ray(K, uv)  # z component 1
+    R_wc = G.view_rotation(yaw)
+    t_wc = jnp.array([pose[0], pose[1], cfg.eye_height], jnp.float32)
+    d_w = G.matvec3(R_wc, d_c)
+    norm = jnp.sqrt(d_w[0] * d_w[0] + d_w[1] * d_w[1] + d_w[2] * d_w[2])
+    u = d_w / norm
+    # depth by ray casting: voxel traversal with exact primitive tests (SR.march). A surface whose
+    # horizontal distance exceeds horizon + pullback yields the same clipped waypoint as no surface,
+    # so the ray is followed only that far (as a 3-D range, for rays up to DEPTH_ELEVATION steep).
+    horiz = jnp.sqrt(u[0] * u[0] + u[1] * u[1])
+    reach = (cfg.horizon + cfg.pullback + world.bank.grid.resolution) / jnp.maximum(horiz, 1e-3)
+    static = min(cfg.depth_range, (cfg.horizon + cfg.pullback + world.bank.grid.resolution) / math.cos(DEPTH_ELEVATION))
+    dist = SR.march(world.bank.rays, s, t_wc, u, jnp.minimum(jnp.minimum(reach, static), cfg.depth_range),
+                    static_range=static, outside_hits=False, exact=DEPTH_EXACT_PRIMS,
+                    iterations=DEPTH_ITERATIONS)
+    valid_depth = jnp.isfinite(dist) & (dist <= cfg.depth_range)
+    z = jnp.where(valid_depth, dist / norm, 0.0)  # z-depth along the optical axis (d_c has z = 1)
+    x_c = G.backproject(K, uv, z)
+    x_w = G.camera_to_world(R_wc, t_wc, x_c)
+    floor_pt, floor_ok = G.floor_intersection(t_wc, d_w)
+    hit_floor_surface = valid_depth & (x_w[2] < 0.02)
+    use_depth = valid_depth
+    point = jnp.where(use_depth, x_w, jnp.where(floor_ok, floor_pt, t_wc + u * cfg.horizon))
+    wp = point[:2]
+    delta = wp - pose[:2]
+    r = jnp.linalg.norm(delta)
+    dir_xy = jnp.where(r > 1e-6, delta / jnp.maximum(r, 1e-6), jnp.stack([jnp.cos(yaw), jnp.sin(yaw)]))
+    hit_obstacle = use_depth & ~hit_floor_surface
+    r = jnp.where(hit_obstacle, jnp.maximum(r - cfg.pullback, 0.0), r)
+    r = jnp.where(~use_depth & ~floor_ok, cfg.horizon, r)
+    r = jnp.minimum(r, cfg.horizon)
+    return pose[:2] + r * dir_xy, hit_obstacle, use_depth, ~use_depth & floor_ok
+
+
+def forward_free(world: World, s, xy, heading):
+    """() free distance ahead at the collision heights (all heights at once, probe map)."""
+    cfg = world.config
+    res = world.bank.grid.resolution
+    mask = (1 << len(cfg.collision_heights)) - 1
+    return probe_free(world, s, xy, heading, mask, cfg.collision_distance + res, res / FINE)
+
+
+def _probe(world: World, s, xy, h, length):
+    """One candidate heading of a micro-step: (free, full) - whether the heading
+    is free (collision rays clear and its full or half step navigable) and
+    whether its full step is navigable.
+
+    One march over the probe map answers the collision rays at every height;
+    the samples within the step's length check the navigability of every cell
+    along it (no hopping over a thin gap into another component)."""
+    cfg = world.config
+    res = world.bank.grid.resolution
+    spacing = res / FINE  # one sample per fine cell: nothing thicker than a fine cell is skipped
+    n_samples = int(math.ceil((cfg.collision_distance + res) / spacing))
+    t = jnp.arange(1, n_samples + 1, dtype=jnp.float32) * spacing  # Shape: (n,)
+    col_mask = (1 << len(cfg.collision_heights)) - 1
+    n_nav = min(int(math.ceil(cfg.micro_step / spacing)), n_samples)  # samples a micro-step can reach
+    t_nav = t[:n_nav]
+    u = jnp.stack([jnp.cos(h), jnp.sin(h)])
+    pts = xy[None] + t[:, None] * u[None]
+    hit = (fine_at(world, s, pts) & col_mask) != 0
+    free = jnp.where(jnp.any(hit), t[jnp.argmax(hit)] - spacing, jnp.float32(cfg.collision_distance + res))
+    nav = navigable_at(world, s, jnp.concatenate([pts[:n_nav], (xy + length * u)[None], (xy + 0.5 * length * u)[None]]))
+    along = nav[:n_nav]
+    full = jnp.all(jnp.where(t_nav <= length, along, True)) & nav[n_nav]
+    half = jnp.all(jnp.where(t_nav <= 0.5 * length, along, True)) & nav[n_nav + 1]
+    return (free >= cfg.collision_distance) & (full | half), full
+
+
+_OFFSETS = (0.0, 1.0, -1.0, 2.0, -2.0, 3.0, -3.0, 4.0)  # candidate headings, x 45 degrees: desired first, left first
+
+
+def execute_moves(world: World, states: T.SimState, direction, col, row, mask, chunk: int | None = None):
+    """Run the executor for the MOVEs of a batch (leading axis B).
+
+    The controller of :mod:`ignjax.sim.env`'s docstring (one episode's :func:`execute_move`
+    is this function on a batch of one), organised so a batch pays only for
+    the work its episodes need (:func:`ignjax.sim.compact.masked_map`):
+    waypoints are cast for the rows in ``mask`` only, micro-steps run while
+    any row is still moving, each micro-step probes the desired heading of
+    the moving rows and the seven neighbouring headings only of the rows
+    whose desired heading is blocked; each row takes the first free heading in
+    :data:`_OFFSETS` order, so a row's result does not depend on the others.
+
+    Args:
+        states: (B,) SimState.
+        direction, col, row: (B,) int32 the MOVE's view and grid cell.
+        mask: (B,) bool rows that execute a MOVE; the other rows' outputs
+            are their current pose, no motion, their minimum distance, no
+            blocked heading and their pose as the waypoint.
+        chunk: rows per vectorised call (:func:`ignjax.sim.compact.chunk_size` by default).
+
+    Returns:
+        (pose (B, 3), moved (B,), min_distance (B,), blocked (B, 8), waypoint (B, 2)).
+    """
+    cfg = world.config
+    ep = states.episode
+    s = ep.scene
+    pose0 = states.pose
+    B = mask.shape[0]
+    wp = masked_map(lambda a: pixel_waypoint(world, *a)[0], mask, (s, pose0, direction, col, row), pose0[:, :2], chunk)
+    yaw0 = pose0[:, 2]
+    offsets = jnp.array(_OFFSETS, jnp.float32) * (math.pi / 4)
+    rows = jnp.arange(B)
+
+    def cond(carry):
+        i, active = carry[0], carry[-1]
+        return (i < cfg.max_micro_steps) & jnp.any(active)
+
+    def micro(carry):
+        i, pose, moved, dmin, blocked, active = carry
+        r, beta = jax.vmap(G.relative_target)(pose[:, :2], pose[:, 2], wp)
+        active = active & (r > cfg.waypoint_tolerance)
+        h0 = pose[:, 2] + beta
+        len0 = jnp.minimum(cfg.micro_step, r)
+        ok0, full0 = masked_map(lambda a: _probe(world, *a), active, (s, pose[:, :2], h0, len0),
+                                (jnp.zeros(B, bool), jnp.zeros(B, bool)), chunk)
+        alt = jax.vmap(lambda s_, xy, h: _probe(world, s_, xy, h, jnp.float32(cfg.micro_step)), in_axes=(None, None, 0))
+        ok_alt, full_alt = masked_map(lambda a: alt(a[0], a[1], a[2] + offsets[1:]), active & ~ok0, (s, pose[:, :2], h0),
+                                      (jnp.zeros((B, 7), bool), jnp.zeros((B, 7), bool)), chunk)
+        ok = jnp.concatenate([ok0[:, None], ok_alt], 1)
+        full = jnp.concatenate([full0[:, None], full_alt], 1)
+        k = jnp.argmax(ok, axis=1)
+        any_ok = jnp.any(ok, axis=1)
+        sec = sector_of(h0 - yaw0)
+        blocked = blocked.at[rows, sec].set(blocked[rows, sec] | (~ok0 & active))
+        heading = h0 + offsets[k]
+        lengths = jnp.where(k == 0, len0, jnp.float32(cfg.micro_step))
+        length = jnp.where(full[rows, k], lengths, 0.5 * lengths)
+        new_xy = pose[:, :2] + length[:, None] * jnp.stack([jnp.cos(heading), jnp.sin(heading)], 1)
+        can = active & any_ok
+        pose = jnp.where(can[:, None], jnp.concatenate([new_xy, heading[:, None]], 1), pose)
+        moved = moved + jnp.where(can, length, 0.0)
+        d_new = jax.vmap(lambda e, xy: geodesic_to_target(world, e, xy))(ep, new_xy)
+        dmin = jnp.where(can, jnp.minimum(dmin, d_new), dmin)
+        return i + 1, pose, moved, dmin, blocked, can
+
+    init = (jnp.int32(0), pose0, jnp.zeros(B, jnp.float32), states.min_distance, jnp.zeros((B, 8), bool), mask)
+    _, pose, moved, dmin, blocked, _ = jax.lax.while_loop(cond, micro, init)
+    pose = jnp.where(mask[:, None], pose.at[:, 2].set(G.wrap_angle(pose[:, 2])), pose)
+    return pose, moved, dmin, blocked, wp
+
+
+def execute_move(world: World, state: T.SimState, direction, col, row):
+    """Run the executor for one MOVE of one episode (:func:`execute_moves` on a batch of one).
+
+    Returns the updated pose, path length moved, minimum geodesic distance,
+    blocked mask and waypoint."""
+    args = T.batch_of_one((state, direction, col, row, jnp.array(True)))
+    return T.only_row(execute_moves(world, *args))

@@ -1,0 +1,91 @@
+"""The observation: what a policy may see of one episode (free-space rays
+per view, visible instances, the room it stands in, budgets and odometry;
+never the target's identity, pose or distance), and the batched update
+that recomputes the perception only for the rows that moved.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import jax
+import jax.numpy as jnp
+
+from ignjax.sim import geometry as G
+from ignjax.sim import types as T
+from ignjax.sim.compact import masked_map
+from ignjax.sim.queries import instance_in_sight, room_at, sector_of
+from ignjax.sim.world import World, march_free, packed_at
+
+
+def observe(world: World, state: T.SimState) -> T.Observation:
+    """What the policy sees (no target identity, pose or distance inside)."""
+    with jax.named_scope("observe"):
+        cfg = world.config
+        bank = world.bank
+        ep = state.episode
+        s = ep.scene
+        pose = state.pose
+        res = bank.grid.resolution
+        R = cfg.obs_rays_per_view
+        half_fov = math.radians(cfg.hfov) / 2
+        within = (jnp.arange(R, dtype=jnp.float32) + 0.5) / R * (2 * half_fov) - half_fov  # Shape: (R,)
+        rel = (jnp.arange(8, dtype=jnp.float32) * (math.pi / 4))[:, None] + within[None]  # Shape: (8, R)
+        heads = pose[2] + rel
+
+        def free(h):  # eye height and LOW_OBS_HEIGHT
+            return march_free(lambda p: packed_at(world, world.packed_obs, 2, s, p) != 0, pose[:2], h, cfg.obs_range, 2 * res)
+
+        free_space = jax.vmap(jax.vmap(free))(heads)
+        # visible instances: K nearest non-structural instances, kept when in sight
+        inst = bank.instances
+        cand = inst.valid[s] & ~inst.structural[s]
+        d = jnp.linalg.norm(inst.center[s, :, :2] - pose[None, :2], axis=1)
+        d = jnp.where(cand & (d <= cfg.obs_range), d, jnp.inf)
+        K = min(cfg.max_visible, inst.valid.shape[1])
+        neg, idx = jax.lax.top_k(-d, K)
+        dist = -neg
+        eye = jnp.array([pose[0], pose[1], cfg.eye_height], jnp.float32)
+        seen = jax.vmap(lambda i: instance_in_sight(world, s, i, eye))(idx) & jnp.isfinite(dist)
+        bearing = G.wrap_angle(jnp.arctan2(inst.center[s, idx, 1] - pose[1], inst.center[s, idx, 0] - pose[0]) - pose[2])
+        handle = jnp.where(seen, idx, -1).astype(jnp.int32)
+        attrs = jnp.stack([inst.color[s, idx], inst.material[s, idx], inst.size[s, idx], inst.state[s, idx]], -1)
+        pad = cfg.max_visible - K
+
+        def padk(x, fill):
+            return jnp.concatenate([x, jnp.full((pad,) + x.shape[1:], fill, x.dtype)]) if pad > 0 else x
+
+        room = room_at(world, s, pose[:2])
+        label = jnp.where(room >= 0, bank.rooms.label[s, jnp.maximum(room, 0)], -1)
+        return T.Observation(
+            free_space=free_space, visible_handle=padk(handle, -1),
+            visible_category=padk(jnp.where(seen, inst.category[s, idx], -1).astype(jnp.int32), -1),
+            visible_attrs=padk(jnp.where(seen[:, None], attrs, -1).astype(jnp.int32), -1),
+            visible_range=padk(jnp.where(seen, dist, jnp.inf), jnp.inf),
+            visible_bearing=padk(jnp.where(seen, bearing, 0.0), 0.0),
+            visible_view=padk(jnp.where(seen, sector_of(bearing), -1), -1),
+            room_label=label.astype(jnp.int32), **state_fields(world, state),
+        )
+
+
+def state_fields(world: World, state: T.SimState) -> dict:
+    """The observation's fields read from the state alone (heading, odometry, budgets, last MOVE)."""
+    cfg = world.config
+    pose, start = state.pose, state.episode.start
+    return dict(
+        heading=pose[2], odometry=jnp.stack([pose[0] - start[0], pose[1] - start[1], G.wrap_angle(pose[2] - start[2])]),
+        goal_category=state.episode.category, steps_left=jnp.int32(cfg.max_steps) - state.step,
+        questions_left=jnp.int32(cfg.max_questions) - jnp.sum(state.n_questions),
+        n_questions=state.n_questions, blocked=state.blocked, last_move=state.last_move,
+    )
+
+
+def observe_batch(world: World, states: T.SimState, previous: T.Observation, moved, chunk: int | None = None) -> T.Observation:
+    """:func:`observe` of a batch (leading axis B) after a step: the
+    perception (rays, visible instances, room) is recomputed for the rows in
+    ``moved`` only; every other row's pose is unchanged, so it keeps
+    ``previous``'s perception with its state fields refreshed. Row for row
+    the same as ``vmap(observe)``."""
+    obs = masked_map(lambda st: observe(world, st), moved, states, previous, chunk)
+    return dataclasses.replace(obs, **jax.vmap(lambda st: state_fields(world, st))(states))
