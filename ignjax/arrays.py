@@ -1,5 +1,6 @@
-"""Array helpers shared by every layer: the one pytree-dataclass decorator
-and the numpy / jax.numpy dispatch of functions that accept either."""
+"""Array helpers shared by every layer: the one pytree-dataclass decorator,
+the numpy / jax.numpy dispatch of functions that accept either, and numeric
+vectors parsed from command-line text."""
 
 from __future__ import annotations
 
@@ -8,6 +9,8 @@ import dataclasses
 import jax
 import jax.numpy as jnp
 import numpy as np
+
+from ignjax.errors import ConfigError
 
 
 def pytree_dataclass(cls=None, *, static: tuple[str, ...] = ()):
@@ -45,4 +48,24 @@ def xp(*arrays):
     return np if all(isinstance(a, host) for a in arrays) else jnp
 
 
-__all__ = ["pytree_dataclass", "xp"]
+def parse_floats(text, n: int, where: str) -> tuple[float, ...]:
+    """Numbers from comma-separated text (a command-line option).
+
+    Args:
+        text: e.g. ``"0.5,1.5,3"``.
+        n: how many numbers are expected; 0 accepts any count.
+        where: the option's name, for the error.
+
+    Raises:
+        ConfigError: naming ``where``, when a field is not a number or the count is wrong.
+    """
+    try:
+        vals = tuple(float(v) for v in str(text).split(","))
+    except ValueError as e:
+        raise ConfigError(None, where, f"expected {n or 'some'} comma-separated numbers, got {text!r}") from e
+    if n and len(vals) != n:
+        raise ConfigError(None, where, f"expected {n} comma-separated numbers, got {len(vals)} in {text!r}")
+    return vals
+
+
+__all__ = ["parse_floats", "pytree_dataclass", "xp"]

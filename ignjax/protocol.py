@@ -21,7 +21,7 @@ from __future__ import annotations
 QUESTION_TYPES: tuple[str, ...] = ("appearance", "region", "route", "confirmation")
 """Question type names; type code ``t`` (1..4) is ``QUESTION_TYPES[t - 1]``."""
 N_QUESTION_TYPES = len(QUESTION_TYPES)
-TYPE_LABELS: tuple[str, ...] = tuple(f"Type {t}" for t in range(1, N_QUESTION_TYPES + 1))
+TYPE_LABELS: tuple[str, ...] = tuple(f"Type {t} {name}" for t, name in enumerate(QUESTION_TYPES, 1))
 """Short labels of the question types for tables and figures."""
 
 LOCKED_COSTS: tuple[float, float, float, float] = (0.182, 0.162, 0.240, 0.103)

@@ -2,6 +2,10 @@
 
 import sys
 
-from ignjax.build.cli import main
+from ignjax.scenes.viz import headless_gl
+
+headless_gl()  # before anything imports mujoco
+
+from ignjax.build.cli import main  # noqa: E402
 
 sys.exit(main())

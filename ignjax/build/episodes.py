@@ -29,18 +29,9 @@ import sys
 import warnings
 from pathlib import Path
 
+from ignjax.arrays import parse_floats
 from ignjax.errors import ConfigError, SceneError
 from ignjax.scenes.io.sources import scene_sources
-
-
-def _floats(text: str, n: int, where: str) -> tuple[float, ...]:
-    try:
-        vals = tuple(float(v) for v in str(text).split(","))
-    except ValueError as e:
-        raise ConfigError(None, where, f"expected {n} comma-separated numbers, got {text!r}") from e
-    if len(vals) != n:
-        raise ConfigError(None, where, f"expected {n} comma-separated numbers, got {len(vals)} in {text!r}")
-    return vals
 
 
 def _out_paths(out: Path) -> dict[str, Path]:
@@ -74,8 +65,8 @@ def build_episodes(args) -> int:
         raise ConfigError(None, "--out", f"must end in .jsonl or .jsonl.gz, got {out.name!r}")
     if args.subset < 0:
         raise ConfigError(None, "--subset", f"must be >= 0, got {args.subset}")
-    alpha = validate_alpha(_floats(args.alpha, 4, "--alpha"), normalize=args.normalize_alpha, where="--alpha")
-    thresholds = validate_thresholds(_floats(args.thresholds, 2, "--thresholds"), where="--thresholds")
+    alpha = validate_alpha(parse_floats(args.alpha, 4, "--alpha"), normalize=args.normalize_alpha, where="--alpha")
+    thresholds = validate_thresholds(parse_floats(args.thresholds, 2, "--thresholds"), where="--thresholds")
     config = BuildConfig(seed=args.seed, alpha=alpha, thresholds=thresholds, subset=args.subset,
                          starts_per_target=args.starts)
     sources = scene_sources(args.scenes)

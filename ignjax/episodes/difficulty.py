@@ -47,13 +47,11 @@ from dataclasses import dataclass
 import jax.numpy as jnp
 import numpy as np
 
+from ignjax.arrays import xp as _xp
 from ignjax.errors import ConfigError
-
-DEFAULT_ALPHA: tuple[float, float, float, float] = (0.35, 0.25, 0.15, 0.25)
-DEFAULT_THRESHOLDS: tuple[float, float] = (0.30, 0.60)
-FACTOR_NAMES: tuple[str, ...] = ("F_distractor", "F_room", "F_context", "F_start")
-BIN_NAMES: tuple[str, ...] = ("easy", "medium", "hard")
-BIN_INDEX = {name: i for i, name in enumerate(BIN_NAMES)}
+from ignjax.protocol import BIN_INDEX, BIN_NAMES, FACTOR_NAMES  # noqa: F401  (re-exported for the episode code)
+from ignjax.protocol import DIFFICULTY_ALPHA as DEFAULT_ALPHA
+from ignjax.protocol import DIFFICULTY_THRESHOLDS as DEFAULT_THRESHOLDS
 
 
 @dataclass(frozen=True)
@@ -75,11 +73,6 @@ class FactorNorms:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
                 raise ConfigError(None, f"difficulty.{name}", f"must be a positive finite number, got {v!r}")
-
-
-def _xp(*arrays):
-    """numpy when every input is a numpy array or Python scalar, else jax.numpy."""
-    return np if all(isinstance(a, (np.ndarray, np.generic, int, float, tuple, list)) for a in arrays) else jnp
 
 
 def context_rho(n_anchors, n_unique, n_distractors):

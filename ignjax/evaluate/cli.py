@@ -19,21 +19,13 @@ import sys
 import time
 from pathlib import Path
 
+from ignjax.arrays import parse_floats
 from ignjax.errors import ConfigError, IgnjaxError
-
-
-def _floats(text, n, where):
-    try:
-        vals = tuple(float(v) for v in str(text).split(","))
-    except ValueError as e:
-        raise ConfigError(None, where, f"expected {n} comma-separated numbers, got {text!r}") from e
-    if n and len(vals) != n:
-        raise ConfigError(None, where, f"expected {n} numbers, got {len(vals)}")
-    return vals
+from ignjax.protocol import LOCKED_COSTS, SUCCESS_THRESHOLDS
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from ignjax.agents.base import registry
+    from ignjax.agents import registry
 
     agents = registry()
     p = argparse.ArgumentParser(prog="python -m ignjax.evaluate", description=__doc__.split("\n\n")[0],
@@ -48,8 +40,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "more on machines with more cores)")
     p.add_argument("--seed", type=int, default=0, help="seed of the agents' randomness (default 0)")
     p.add_argument("--scenes-root", help="where to look for scene files the episode file names, if not next to it")
-    p.add_argument("--thresholds", default="0.5,1.5,3", help="success thresholds in metres (default 0.5,1.5,3)")
-    p.add_argument("--costs", default="0.182,0.162,0.240,0.103", help="per-type question costs for WSR")
+    p.add_argument("--thresholds", default=",".join(f"{t:g}" for t in SUCCESS_THRESHOLDS),
+                   help="success thresholds in metres (default %(default)s)")
+    p.add_argument("--costs", default=",".join(f"{c:.3f}" for c in LOCKED_COSTS),
+                   help="per-type question costs for WSR (default: the locked costs %(default)s)")
     p.add_argument("--no-require-stop", dest="require_stop", action="store_false",
                    help="count an episode as a success when it ends close enough, even without STOP")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
@@ -69,14 +63,14 @@ def run(args) -> int:
     from tqdm.auto import tqdm
 
     from ignjax.evaluate import metrics as M
-    from ignjax.agents.base import get_agent
+    from ignjax.agents import get_agent
     from ignjax.episodes.dataset import load_benchmark
     from ignjax.evaluate.runner import make_world, run_agent
     from ignjax.evaluate.outcomes import metric_rows, outcome_rows, write_metric_table, write_outcomes
 
     agents = [get_agent(a) for a in args.agent]
-    thresholds = _floats(args.thresholds, 0, "--thresholds")
-    costs = _floats(args.costs, 4, "--costs")
+    thresholds = parse_floats(args.thresholds, 0, "--thresholds")
+    costs = parse_floats(args.costs, 4, "--costs")
     if any(c < 0 for c in costs) or any(c != c for c in costs):
         raise ConfigError(None, "--costs", f"costs must be non-negative numbers, got {costs}")
     if args.batch < 1:
@@ -99,7 +93,7 @@ def run(args) -> int:
     p_parquet, p_csv = write_outcomes(rows, out_dir)
     metrics = metric_rows(rows, thresholds, costs, args.require_stop)
     write_metric_table(metrics, out_dir / "metrics.csv")
-    if all(t in thresholds for t in (0.5, 1.5, 3.0)):
+    if all(t in thresholds for t in SUCCESS_THRESHOLDS):
         print(M.table1(metrics, "text"))
     print(f"wrote {p_parquet}, {p_csv} and {out_dir / 'metrics.csv'}")
     return 0

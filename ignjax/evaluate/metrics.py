@@ -24,52 +24,13 @@ segment sums, so the same code runs on one agent's 500 episodes or on
 
 from __future__ import annotations
 
-import dataclasses
-from dataclasses import dataclass
-
-import jax
 import jax.numpy as jnp
 import numpy as np
 
-LOCKED_COSTS: tuple[float, float, float, float] = (0.182, 0.162, 0.240, 0.103)
-"""The paper's locked per-type costs (Type 1 appearance, 2 region, 3 route, 4 confirmation)."""
-DEFAULT_THRESHOLDS: tuple[float, ...] = (0.5, 1.5, 3.0)
-QUESTION_TYPES: tuple[str, ...] = ("appearance", "region", "route", "confirmation")
-
-
-@jax.tree_util.register_dataclass
-@dataclass(frozen=True)
-class Outcomes:
-    """Per-episode outcomes needed by the metrics (a pytree of arrays).
-
-    Attributes:
-        final_distance: (..., E) float32, distance to the target at the end, m.
-        min_distance: (..., E) float32, smallest distance along the path, m.
-        path_length: (..., E) float32, metres travelled.
-        stopped: (..., E) bool, the episode ended with a STOP action.
-        n_questions: (..., E, 4) int32, charged questions per type.
-        difficulty: (..., E) int32, bin index (0 easy, 1 medium, 2 hard).
-        valid: (..., E) bool, rows that count (padding is False).
-    """
-
-    final_distance: jax.Array
-    min_distance: jax.Array
-    path_length: jax.Array
-    stopped: jax.Array
-    n_questions: jax.Array
-    difficulty: jax.Array
-    valid: jax.Array
-
-    @staticmethod
-    def from_numpy(**columns) -> "Outcomes":
-        """Build from numpy columns; ``valid`` defaults to all True."""
-        n = np.asarray(columns["final_distance"]).shape
-        columns.setdefault("valid", np.ones(n, bool))
-        return Outcomes(**{f.name: np.asarray(columns[f.name]) for f in dataclasses.fields(Outcomes)})
-
-
-def _xp(*arrays):
-    return np if all(isinstance(a, (np.ndarray, np.generic, float, int, tuple, list)) for a in arrays) else jnp
+from ignjax.arrays import xp as _xp
+from ignjax.protocol import BIN_NAMES, LOCKED_COSTS, N_QUESTION_TYPES
+from ignjax.protocol import SUCCESS_THRESHOLDS as DEFAULT_THRESHOLDS
+from ignjax.sim.types import OutcomeRow
 
 
 def episode_success(final_distance, stopped, thresholds=DEFAULT_THRESHOLDS, require_stop: bool = True):
@@ -110,7 +71,7 @@ def _masked_mean(x, mask, xp, axis):
     return (x * m).sum(axis) / xp.maximum(m.sum(axis), 1)
 
 
-def summarize(outcomes: Outcomes, thresholds=DEFAULT_THRESHOLDS, costs=LOCKED_COSTS, require_stop: bool = True,
+def summarize(outcomes: OutcomeRow, thresholds=DEFAULT_THRESHOLDS, costs=LOCKED_COSTS, require_stop: bool = True,
               groups=None, n_groups: int | None = None) -> dict:
     """All metrics, optionally per group.
 
@@ -184,12 +145,12 @@ def _fmt_tau(t: float) -> str:
     return f"{t:g}"
 
 
-def metric_row(outcomes: Outcomes, thresholds=DEFAULT_THRESHOLDS, costs=LOCKED_COSTS, require_stop: bool = True) -> dict:
+def metric_row(outcomes: OutcomeRow, thresholds=DEFAULT_THRESHOLDS, costs=LOCKED_COSTS, require_stop: bool = True) -> dict:
     """One agent's metrics as a flat dict of Python floats (percentages for
     SR/OSR/WSR, as the paper reports them), overall and per difficulty."""
     thresholds = tuple(float(t) for t in thresholds)
     overall = summarize(outcomes, thresholds, costs, require_stop)
-    per = summarize(outcomes, thresholds, costs, require_stop, groups=outcomes.difficulty, n_groups=3)
+    per = summarize(outcomes, thresholds, costs, require_stop, groups=outcomes.difficulty, n_groups=len(BIN_NAMES))
     row: dict[str, float] = {"episodes": int(np.asarray(overall["count"]))}
     for i, t in enumerate(thresholds):
         row[f"SR@{_fmt_tau(t)}"] = 100 * float(overall["SR"][i])
@@ -197,10 +158,10 @@ def metric_row(outcomes: Outcomes, thresholds=DEFAULT_THRESHOLDS, costs=LOCKED_C
         row[f"WSR@{_fmt_tau(t)}"] = 100 * float(overall["WSR"][i])
     row["NE"] = float(overall["NE"])
     row["TL"] = float(overall["TL"])
-    for q in range(4):
+    for q in range(N_QUESTION_TYPES):
         row[f"Q{q + 1}"] = float(overall["Q"][q])
     row["|Q|"] = float(overall["Q_total"])
-    for g, name in enumerate(("easy", "medium", "hard")):
+    for g, name in enumerate(BIN_NAMES):
         row[f"{name}.episodes"] = int(np.asarray(per["count"])[g])
         for i, t in enumerate(thresholds):
             row[f"{name}.SR@{_fmt_tau(t)}"] = 100 * float(per["SR"][g, i])
@@ -209,9 +170,23 @@ def metric_row(outcomes: Outcomes, thresholds=DEFAULT_THRESHOLDS, costs=LOCKED_C
         row[f"{name}.NE"] = float(per["NE"][g])
         row[f"{name}.TL"] = float(per["TL"][g])
         row[f"{name}.|Q|"] = float(per["Q_total"][g])
-        for q in range(4):
+        for q in range(N_QUESTION_TYPES):
             row[f"{name}.Q{q + 1}"] = float(per["Q"][g, q])
     return row
+
+
+def md_table(header: list[str], rows: list[list]) -> str:
+    """A markdown table: strings as given, floats to 4 significant digits (``nan`` when not finite)."""
+    def cell(v):
+        if isinstance(v, str):
+            return v
+        if isinstance(v, (float, np.floating)):
+            return "nan" if not np.isfinite(float(v)) else f"{float(v):.4g}"
+        return str(v)
+
+    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
+    lines += ["| " + " | ".join(cell(v) for v in r) + " |" for r in rows]
+    return "\n".join(lines)
 
 
 def table1(rows: dict[str, dict], fmt: str = "markdown") -> str:
@@ -237,8 +212,6 @@ def table1(rows: dict[str, dict], fmt: str = "markdown") -> str:
     header = ["Agent"] + list(TABLE1_COLUMNS)
     body = [[name] + [cell(r, c) for c in TABLE1_COLUMNS] for name, r in rows.items()]
     if fmt == "markdown":
-        lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
-        lines += ["| " + " | ".join(r) + " |" for r in body]
-        return "\n".join(lines)
+        return md_table(header, body)
     widths = [max(len(str(x)) for x in col) for col in zip(header, *body)]
     return "\n".join("  ".join(str(x).rjust(w) for x, w in zip(r, widths)) for r in [header] + body)

@@ -37,10 +37,10 @@ from pathlib import Path
 import numpy as np
 
 from ignjax.evaluate import metrics as M
-from ignjax.episodes.difficulty import BIN_INDEX, BIN_NAMES
+from ignjax.protocol import BIN_INDEX, BIN_NAMES, LOCKED_COSTS, SUCCESS_THRESHOLDS
 from ignjax.errors import InputError
 from ignjax.fileio import atomic_write
-from ignjax.sim.types import STOP_REASONS
+from ignjax.sim.types import STOP_REASONS, OutcomeRow
 
 COLUMNS: tuple[str, ...] = (
     "agent", "episode_id", "scene_id", "difficulty", "final_distance", "final_euclidean", "min_distance",
@@ -65,7 +65,7 @@ def parse_trace(text: str) -> list[tuple[int, int, bool]]:
 
 
 def outcome_rows(agent: str, records: list[dict], out) -> list[dict]:
-    """Rows of an outcome table from a rollout's :class:`~ignjax.sim.env.OutcomeRow`
+    """Rows of an outcome table from a rollout's :class:`~ignjax.sim.types.OutcomeRow`
     (numpy or JAX arrays with leading axis E matching ``records``)."""
     o = {k: np.asarray(getattr(out, k)) for k in ("final_distance", "final_euclidean", "min_distance", "path_length",
                                                   "steps", "stopped", "stop_reason", "n_questions", "n_refused",
@@ -154,25 +154,39 @@ def read_outcomes(path: str | os.PathLike) -> list[dict]:
     return rows
 
 
-def to_metric_outcomes(rows: list[dict], distance: str = "geodesic") -> M.Outcomes:
-    """Arrays for :func:`ignjax.evaluate.metrics.summarize` from table rows.
+def to_metric_outcomes(rows: list[dict], distance: str = "geodesic") -> OutcomeRow:
+    """The rollout's outcome type (:class:`~ignjax.sim.types.OutcomeRow`, numpy
+    arrays with a leading episode axis) from table rows, for
+    :func:`ignjax.evaluate.metrics.summarize`.
 
     Args:
         distance: ``"geodesic"`` (default) or ``"euclidean"`` final distance
             for success; OSR always uses the geodesic minimum along the path.
     """
     key = {"geodesic": "final_distance", "euclidean": "final_euclidean"}[distance]
-    return M.Outcomes.from_numpy(
+    traces = [parse_trace(r["trace"]) for r in rows]
+    T = max((len(t) for t in traces), default=0)
+    trace = np.zeros((len(rows), T, 3), np.int64)
+    for i, t in enumerate(traces):
+        if t:
+            trace[i, : len(t)] = t
+    return OutcomeRow.from_numpy(
         final_distance=np.array([r[key] for r in rows], float),
+        final_euclidean=np.array([r["final_euclidean"] for r in rows], float),
         min_distance=np.array([r["min_distance"] for r in rows], float),
         path_length=np.array([r["path_length"] for r in rows], float),
+        steps=np.array([r["steps"] for r in rows], np.int64),
         stopped=np.array([r["stopped"] for r in rows], bool),
+        stop_reason=np.array([STOP_REASONS.index(r["stop_reason"]) for r in rows], np.int64),
         n_questions=np.array([[r["q1"], r["q2"], r["q3"], r["q4"]] for r in rows], np.int64),
+        n_refused=np.array([r["n_refused"] for r in rows], np.int64),
+        n_invalid=np.array([r["n_invalid"] for r in rows], np.int64),
+        trace_type=trace[..., 0], trace_step=trace[..., 1], trace_charged=trace[..., 2].astype(bool),
         difficulty=np.array([BIN_INDEX[r["difficulty"]] for r in rows], np.int64),
     )
 
 
-def metric_rows(rows: list[dict], thresholds=M.DEFAULT_THRESHOLDS, costs=M.LOCKED_COSTS, require_stop: bool = True,
+def metric_rows(rows: list[dict], thresholds=SUCCESS_THRESHOLDS, costs=LOCKED_COSTS, require_stop: bool = True,
                 distance: str = "geodesic") -> dict[str, dict]:
     """Agent -> :func:`ignjax.evaluate.metrics.metric_row`, recomputed from table rows."""
     agents: dict[str, list[dict]] = {}

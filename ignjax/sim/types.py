@@ -19,6 +19,7 @@ Codes
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -359,6 +360,32 @@ class OutcomeRow:
     trace_charged: jax.Array
     difficulty: jax.Array
     valid: jax.Array
+
+    METRIC_FIELDS = ("final_distance", "min_distance", "path_length", "stopped", "n_questions", "difficulty")
+    """The columns every metric needs (:mod:`ignjax.evaluate.metrics`)."""
+
+    @staticmethod
+    def from_numpy(**columns) -> "OutcomeRow":
+        """Outcomes of many episodes from numpy columns (any leading shape).
+
+        The :attr:`METRIC_FIELDS` are required; ``valid`` defaults to all
+        True; other fields not given are zeros (``final_euclidean`` the
+        final distance, question traces of length 0).
+        """
+        missing = [k for k in OutcomeRow.METRIC_FIELDS if k not in columns]
+        if missing:
+            raise TypeError(f"OutcomeRow.from_numpy: missing columns {missing}")
+        shape = np.shape(columns["final_distance"])
+        defaults = {"final_euclidean": columns["final_distance"], "valid": np.ones(shape, bool),
+                    "steps": np.zeros(shape, np.int32), "stop_reason": np.zeros(shape, np.int32),
+                    "n_refused": np.zeros(shape, np.int32), "n_invalid": np.zeros(shape, np.int32),
+                    "trace_type": np.zeros(shape + (0,), np.int32), "trace_step": np.zeros(shape + (0,), np.int32),
+                    "trace_charged": np.zeros(shape + (0,), bool)}
+        unknown = set(columns) - {f.name for f in dataclasses.fields(OutcomeRow)}
+        if unknown:
+            raise TypeError(f"OutcomeRow.from_numpy: unknown columns {sorted(unknown)}")
+        return OutcomeRow(**{f.name: np.asarray(columns[f.name] if f.name in columns else defaults[f.name])
+                             for f in dataclasses.fields(OutcomeRow)})
 
 
 @pytree_dataclass

@@ -9,9 +9,6 @@ import numpy as np
 
 from ignjax.errors import InputError
 
-BIN_NAMES: tuple[str, ...] = ("easy", "medium", "hard")
-TYPE_LABELS: tuple[str, ...] = ("Type 1 appearance", "Type 2 region", "Type 3 route", "Type 4 confirmation")
-
 
 def as_array(x, name: str, *, ndim: int | tuple[int, ...] | None = None, last: int | None = None,
              dtype=None, finite: bool = False) -> np.ndarray:

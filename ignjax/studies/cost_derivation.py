@@ -46,6 +46,7 @@ from pathlib import Path
 import numpy as np
 
 from ignjax.errors import ConfigError, InputError
+from ignjax.protocol import LOCKED_COSTS
 
 CUES: tuple[str, ...] = (
     "target_identity", "endpoint",
@@ -65,7 +66,6 @@ CUE_TO_TYPE: dict[str, int] = {
 }
 """Cue -> question type 1..4 (Table app:cue-collapse)."""
 
-LOCKED_COSTS = (0.182, 0.162, 0.240, 0.103)
 GAIN_LEVELS = ("low", "medium", "high")
 _PROXY = {"shape": "color", "size": "color", "material": "color", "state": "color", "support_placement": "spatial_relation"}
 

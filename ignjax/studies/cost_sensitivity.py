@@ -54,9 +54,10 @@ import numpy as np
 from ignjax.evaluate import metrics as M
 from ignjax.studies.cost_derivation import simplex_grid
 from ignjax.errors import ConfigError, InputError
-from ignjax.studies._common import TYPE_LABELS, as_array, new_figure, save
+from ignjax.protocol import LOCKED_COSTS, TYPE_LABELS
+from ignjax.studies._common import as_array, new_figure, save
 
-LOCKED = np.asarray(M.LOCKED_COSTS, dtype=np.float64)
+LOCKED = np.asarray(LOCKED_COSTS, dtype=np.float64)
 LOCKED_SUM = float(LOCKED.sum())
 """Sum of the locked costs, 0.687: the scale of sampled cost vectors."""
 UNIFORM = np.full(4, LOCKED_SUM / 4)

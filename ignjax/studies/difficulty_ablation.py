@@ -26,9 +26,12 @@ import numpy as np
 from scipy.stats import rankdata
 
 from ignjax.studies.cost_derivation import simplex_grid
-from ignjax.episodes.difficulty import DEFAULT_ALPHA, DEFAULT_THRESHOLDS, FACTOR_NAMES, difficulty_score
+from ignjax.episodes.difficulty import difficulty_score
 from ignjax.errors import ConfigError, InputError
-from ignjax.studies._common import BIN_NAMES, as_array, new_figure, save
+from ignjax.protocol import BIN_NAMES, FACTOR_NAMES
+from ignjax.protocol import DIFFICULTY_ALPHA as DEFAULT_ALPHA
+from ignjax.protocol import DIFFICULTY_THRESHOLDS as DEFAULT_THRESHOLDS
+from ignjax.studies._common import as_array, new_figure, save
 
 EMPTY_RULES = ("unordered", "skip")
 

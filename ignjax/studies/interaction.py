@@ -87,7 +87,8 @@ import numpy as np
 from scipy import ndimage
 
 from ignjax.errors import ConfigError, InputError
-from ignjax.studies._common import BIN_NAMES, TYPE_LABELS, as_array, new_figure, save
+from ignjax.protocol import BIN_NAMES, TYPE_LABELS
+from ignjax.studies._common import as_array, new_figure, save
 
 LOCATION_CLASSES: tuple[str, ...] = ("corridor", "junction", "dead_end", "room")
 CORRIDOR, JUNCTION, DEAD_END, ROOM = range(4)

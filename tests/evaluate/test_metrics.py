@@ -1,5 +1,6 @@
 """Metrics against a plain-Python reference on hand-built outcome tables."""
 
+import dataclasses
 import math
 
 import jax
@@ -8,6 +9,7 @@ import numpy as np
 import pytest
 
 from ignjax.evaluate import metrics as M
+from ignjax.sim.types import OutcomeRow
 
 
 def _reference(rows, thresholds, costs, require_stop=True):
@@ -34,7 +36,7 @@ def _reference(rows, thresholds, costs, require_stop=True):
 
 
 def _table(rows):
-    return M.Outcomes.from_numpy(
+    return OutcomeRow.from_numpy(
         final_distance=np.array([r["d"] for r in rows]), min_distance=np.array([r["dmin"] for r in rows]),
         path_length=np.array([r["tl"] for r in rows]), stopped=np.array([r["stop"] for r in rows]),
         n_questions=np.array([r["q"] for r in rows]), difficulty=np.array([r["bin"] for r in rows]))
@@ -87,7 +89,7 @@ def test_groups_by_difficulty_equal_reference_on_subsets():
 
 def test_masked_rows_are_ignored():
     t = _table(ROWS + [dict(d=0.0, dmin=0.0, tl=0.0, stop=True, q=[9, 9, 9, 9], bin=0)])
-    t = M.Outcomes(**{**t.__dict__, "valid": np.array([True] * len(ROWS) + [False])})
+    t = dataclasses.replace(t, valid=np.array([True] * len(ROWS) + [False]))
     a, b = M.summarize(t), M.summarize(_table(ROWS))
     for k in a:
         np.testing.assert_allclose(a[k], b[k])

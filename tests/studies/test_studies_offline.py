@@ -18,6 +18,7 @@ from ignjax.errors import ConfigError, InputError
 from ignjax.studies import cost_sensitivity as CS
 from ignjax.studies import difficulty_ablation as DA
 from ignjax.studies import interaction as IA
+from ignjax.sim.types import OutcomeRow
 
 PNG = b"\x89PNG\r\n\x1a\n"
 
@@ -89,7 +90,7 @@ def test_locked_costs_reproduce_summarize():
     wsr = CS.offline_wsr(success, n, None, costs)
     per = CS.offline_wsr(success, n, None, costs, difficulty=diff)
     for a in range(A):
-        o = M.Outcomes.from_numpy(final_distance=fd[a], min_distance=fd[a], path_length=fd[a], stopped=stopped[a],
+        o = OutcomeRow.from_numpy(final_distance=fd[a], min_distance=fd[a], path_length=fd[a], stopped=stopped[a],
                                   n_questions=n[a], difficulty=diff)
         s = M.summarize(o, thr, M.LOCKED_COSTS)
         np.testing.assert_allclose(wsr[0, a], s["WSR"], rtol=2e-6)

@@ -26,12 +26,11 @@ import os
 import sys
 from typing import Iterable, Sequence
 
-os.environ.setdefault("MUJOCO_GL", "egl")
+import numpy as np
 
-import numpy as np  # noqa: E402
-
-from ignjax.scenes.procgen import catalogue as cat  # noqa: E402
-from ignjax.scenes.model import Attributes, Room, Scene, SceneMeta, Wall  # noqa: E402
+from ignjax.scenes.model import Attributes, Room, Scene, SceneMeta, Wall
+from ignjax.scenes.procgen import catalogue as cat
+from ignjax.scenes.viz import headless_gl
 
 FOVY = 40.0
 """Vertical field of view of the gallery camera, degrees."""
@@ -194,4 +193,5 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
+    headless_gl()
     raise SystemExit(main())

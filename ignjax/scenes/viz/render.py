@@ -6,20 +6,24 @@ y down, z forward; the agent's eye looks along heading ``yaw`` (radians,
 counter-clockwise from +X) tilted by ``pitch`` (radians, positive up).
 View ``k`` of the 8-view panorama looks along ``yaw + k * 45 degrees``.
 
-Rendering uses OpenGL through EGL (headless Mesa on a CPU machine, the
-NVIDIA driver on a GPU machine): importing :mod:`ignjax` sets
-``MUJOCO_GL=egl`` unless the user chose another backend.
+Rendering uses OpenGL through the backend MuJoCo chose from ``MUJOCO_GL``
+when it was imported: EGL (headless Mesa on a CPU machine, the NVIDIA driver
+on a GPU machine) after :func:`ignjax.scenes.viz.headless_gl`, which the
+command lines call first. Without ``MUJOCO_GL`` and without a display,
+:class:`ViewRenderer` says so instead of failing inside OpenGL.
 """
 
 from __future__ import annotations
 
 import math
 import os
+import sys
 
 import mujoco
 import numpy as np
 
-VIEW_NAMES = ("front", "front-left", "left", "rear-left", "rear", "rear-right", "right", "front-right")
+from ignjax.errors import IgnjaxError
+from ignjax.protocol import VIEW_NAMES  # noqa: F401  (view k's name, for callers labelling views)
 
 
 def intrinsics(width: int, height: int, hfov_deg: float = 90.0) -> np.ndarray:
@@ -49,6 +53,10 @@ class ViewRenderer:
     """
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, width: int = 320, height: int = 320, hfov_deg: float = 90.0):
+        if sys.platform.startswith("linux") and not os.environ.get("MUJOCO_GL") and not os.environ.get("DISPLAY"):
+            raise IgnjaxError("no OpenGL backend for rendering: there is no display and MUJOCO_GL is unset; set "
+                              "MUJOCO_GL=egl (headless) before mujoco is imported, or call "
+                              "ignjax.scenes.viz.headless_gl() first")
         self.model, self.data = model, data
         self.width, self.height, self.hfov_deg = int(width), int(height), float(hfov_deg)
         self._renderer = mujoco.Renderer(model, height=self.height, width=self.width)
