@@ -1,77 +1,353 @@
-"""Configuration of ``python -m ignjax.sweep``: defaults, TOML files, ``--set`` overrides.
+"""Configuration of ``python -m ignjax.sweep``: one frozen dataclass tree.
 
-A configuration is a two-level mapping ``section -> key -> value``. The
-defaults below are the whole schema: a TOML file or a ``--set`` that names
-a section or key not in it is an error (with the file and line for TOML).
-``--quick`` replaces a few sizes by :data:`QUICK` (CI and smoke runs).
+:class:`SweepConfig` has one section per TOML table: ``run``, ``benchmark``,
+``eval``, ``costs``, ``difficulty``, ``derive-costs`` (attribute
+``derive_costs``), ``analysis`` and ``sim`` (the simulator's own
+:class:`ignjax.sim.types.SimConfig`). Each section checks its values in
+``__post_init__`` and raises :class:`ConfigError` naming the key, so a
+configuration built from Python is checked like one read from a file.
+
+:func:`resolve` layers defaults <- :data:`QUICK` (``--quick``) <- a TOML file
+<- ``--set section.key=value`` items (later wins); a name not in the schema,
+a value of the wrong type or one that fails a check is an error naming the
+file and line (or ``--set``) and the key. :func:`fingerprint` hashes a
+configuration and the studies (``run.json``). ``sweeps/default.toml`` is
+:func:`default_toml`'s text (a test keeps them equal); regenerate it with
+``python -c "from ignjax.config import default_toml; print(default_toml(), end='')" > sweeps/default.toml``.
 """
 
 from __future__ import annotations
 
-import copy
+import dataclasses
+import functools
 import hashlib
 import json
 import math
 import os
+import textwrap
 import tomllib
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
+from ignjax.agents import registry
+from ignjax.episodes.difficulty import validate_alpha, validate_thresholds
 from ignjax.errors import ConfigError
+from ignjax.protocol import DIFFICULTY_ALPHA, DIFFICULTY_THRESHOLDS, LOCKED_COSTS, SUCCESS_THRESHOLDS
+from ignjax.sim.types import SimConfig
+from ignjax.studies.cost_sensitivity import validate_costs
 
-STUDIES: tuple[str, ...] = ("eval", "costs", "difficulty", "derive-costs", "analysis")
+# ---------------------------------------------------------------------------
+# value checks shared by every section
+# ---------------------------------------------------------------------------
 
-DEFAULTS: dict[str, dict[str, Any]] = {
-    "run": {
-        "name": "default",  # folder under run.out
-        "out": "runs",
-        "seed": 0,  # PRNG seed of every rollout (per-episode keys fold in the episode index)
-    },
-    "benchmark": {
-        "episodes": "",  # an episode file; empty: the shipped benchmark, or one built from `scenes`
-        "scenes": "",  # scene folder/files to build from; empty: the shipped scenes/ folder
-        "subset": 500,
-        "seed": 0,
-        "limit": 0,  # > 0: use only the first N episodes (quick runs)
-    },
-    "eval": {
-        "agents": ["random", "explorer", "naive_asker", "eig", "shortest_path"],
-        "batch": 256,
-        "parts": 0,  # concurrent pieces of each batch (0: ignjax.sim.rollout.batch_parts, 2 on CPU)
-        "thresholds": [0.5, 1.5, 3.0],
-        "costs": [0.182, 0.162, 0.240, 0.103],
-        "require_stop": True,
-    },
-    "costs": {
-        "samples": 100_000,  # offline cost vectors (simplex sample, sum = locked sum; rows 0/1 locked/uniform)
-        "seed": 0,
-        "agent": "eig",  # the cost-aware agent re-run in the loop
-        "scales": [0.25, 0.5, 1.0, 2.0, 4.0, 8.0],  # in-the-loop: locked costs times each scale
-        "per_type_factor": 4.0,  # in-the-loop: also each type alone times this factor (0: skip)
-        "normalize": False,
-    },
-    "difficulty": {
-        "alpha": [0.35, 0.25, 0.15, 0.25],  # the reference coefficients (distractor, room, context, start)
-        "thresholds": [0.30, 0.60],  # the reference bin thresholds
-        "normalize": False,  # rescale an alpha that does not sum to 1 instead of rejecting it
-        "alpha_step": 0.05,
-        "threshold_step": 0.05,
-        "split_seed": 0,
-        "empty": "unordered",
-    },
-    "derive-costs": {
-        "annotations": "",  # cue-annotation JSONL; empty: the paper's published statistics
-        "assumption": "proxy",
-        "lambdas": [0.3333333333333333, 0.3333333333333333, 0.3333333333333333],
-        "fit": True,
-    },
-    "analysis": {
-        "agent": "eig",
-        "horizon": 5,  # matched horizon of Delta-U, planner steps
-        "radius": 1.0,  # explored-area radius around the path, m
-        "trajectories": 4,  # top-down trajectory plots
-    },
+
+def _check_value(key: str, value: Any, default: Any, where: str | None) -> Any:
+    """``value`` checked against the type of ``default`` (the field's default)
+    and normalised: ints given for floats become floats, lists become tuples."""
+    if isinstance(default, bool):
+        if not isinstance(value, bool):
+            raise ConfigError(where, key, f"expected true or false, got {value!r}")
+        return value
+    if isinstance(default, int):
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ConfigError(where, key, f"expected an integer, got {value!r}")
+        return value
+    if isinstance(default, float):
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise ConfigError(where, key, f"expected a finite number, got {value!r}")
+        return float(value)
+    if isinstance(default, str):
+        if not isinstance(value, str):
+            raise ConfigError(where, key, f"expected a string, got {value!r}")
+        return value
+    if isinstance(default, tuple):
+        if not isinstance(value, (list, tuple)):
+            raise ConfigError(where, key, f"expected a list, got {value!r}")
+        if default and all(isinstance(v, int) and not isinstance(v, bool) for v in default):
+            if any(isinstance(v, bool) or not isinstance(v, int) for v in value):
+                raise ConfigError(where, key, f"expected integers, got {list(value)!r}")
+            return tuple(value)
+        if default and isinstance(default[0], (int, float)) and not isinstance(default[0], bool):
+            for v in value:
+                if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                    raise ConfigError(where, key, f"expected finite numbers, got {list(value)!r}")
+            return tuple(float(v) for v in value)
+        if default and isinstance(default[0], str) and not all(isinstance(v, str) for v in value):
+            raise ConfigError(where, key, f"expected strings, got {list(value)!r}")
+        return tuple(value)
+    return value
+
+
+def _check_fields(obj, section: str) -> None:
+    """Type-check and normalise every field of a (frozen) section in place."""
+    for f in dataclasses.fields(obj):
+        value = _check_value(f"{section}.{f.name}", getattr(obj, f.name), f.default, None)
+        object.__setattr__(obj, f.name, value)
+
+
+def _check_agent(name: str, key: str) -> None:
+    known = registry()
+    if name not in known:
+        raise ConfigError(None, key, f"unknown agent {name!r}; known: {', '.join(known)}")
+
+
+# ---------------------------------------------------------------------------
+# sections
+# ---------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class RunConfig:
+    """Where a run goes and its seed.
+
+    Attributes:
+        name: folder of the run under ``out`` (also the report's title).
+        out: folder holding the run folders, and ``_benchmarks/`` (benchmarks built from ``benchmark.scenes``,
+            reused across runs).
+        seed: PRNG seed of every rollout (each episode's key folds in its index in the episode file).
+    """
+
+    SECTION: ClassVar[str] = "run"
+    name: str = "default"
+    out: str = "runs"
+    seed: int = 0
+
+    def __post_init__(self):
+        _check_fields(self, self.SECTION)
+
+
+@dataclass(frozen=True)
+class BenchmarkConfig:
+    """The episodes the studies run on.
+
+    Attributes:
+        episodes: an episode file (.jsonl or .jsonl.gz); empty: the shipped scenes/benchmark.jsonl.gz when the
+            other settings of this section are the defaults, else one built from ``scenes``.
+        scenes: scene folder or file to build the benchmark from; empty: the shipped scenes/ folder.
+        subset: episodes in a built benchmark (sampled easy:medium:hard 30:40:30).
+        seed: seed of a built benchmark's random choices.
+        limit: > 0: keep only N episodes spread evenly over the file (quick runs); 0: all.
+    """
+
+    SECTION: ClassVar[str] = "benchmark"
+    episodes: str = ""
+    scenes: str = ""
+    subset: int = 500
+    seed: int = 0
+    limit: int = 0
+
+    def __post_init__(self):
+        _check_fields(self, self.SECTION)
+
+
+@dataclass(frozen=True)
+class EvalConfig:
+    """The evaluation: agents x episodes, and the metrics' settings.
+
+    Attributes:
+        agents: the agents evaluated (names of ``ignjax.agents.registry()``).
+        batch: episodes per compiled rollout.
+        parts: concurrent pieces of each batch; 0: the default split (``ignjax.sim.rollout.batch_parts``, 2 on CPU).
+        thresholds: success distances tau of the SR / OSR / WSR columns, m; positive and increasing.
+        costs: per-type question costs charged by WSR (Type 1 appearance, 2 region, 3 route, 4 confirmation);
+            default the paper's locked costs.
+        require_stop: success also requires an explicit STOP.
+    """
+
+    SECTION: ClassVar[str] = "eval"
+    agents: tuple[str, ...] = ("random", "explorer", "naive_asker", "eig", "shortest_path")
+    batch: int = 256
+    parts: int = 0
+    thresholds: tuple[float, ...] = SUCCESS_THRESHOLDS
+    costs: tuple[float, ...] = LOCKED_COSTS
+    require_stop: bool = True
+
+    def __post_init__(self):
+        _check_fields(self, self.SECTION)
+        for name in self.agents:
+            _check_agent(name, "eval.agents")
+        if not self.agents:
+            raise ConfigError(None, "eval.agents", "must name at least one agent")
+        if len(self.costs) != 4:
+            raise ConfigError(None, "eval.costs", f"expected 4 costs (one per question type), got {list(self.costs)}")
+        validate_costs(self.costs, "eval.costs")
+        if self.batch < 1:
+            raise ConfigError(None, "eval.batch", "must be >= 1")
+        if self.parts < 0:
+            raise ConfigError(None, "eval.parts", f"must be >= 0 (0: the default split), got {self.parts}")
+        if tuple(sorted(self.thresholds)) != self.thresholds or any(t <= 0 for t in self.thresholds):
+            raise ConfigError(None, "eval.thresholds", "must be positive and increasing")
+
+
+@dataclass(frozen=True)
+class CostsConfig:
+    """The cost-weight sensitivity study.
+
+    Attributes:
+        samples: offline cost vectors: row 0 the locked costs, row 1 uniform, the rest uniform on the simplex
+            scaled to the locked sum; >= 2.
+        seed: seed of the offline cost sample.
+        agent: the cost-aware agent re-run in the loop under each charged cost vector.
+        scales: in the loop: the locked costs times each scale (positive).
+        per_type_factor: in the loop: also each type's cost alone times this factor; 0: skip.
+        normalize: accepted for existing files; the studies do not read it.
+    """
+
+    SECTION: ClassVar[str] = "costs"
+    samples: int = 100_000
+    seed: int = 0
+    agent: str = "eig"
+    scales: tuple[float, ...] = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0)
+    per_type_factor: float = 4.0
+    normalize: bool = False
+
+    def __post_init__(self):
+        _check_fields(self, self.SECTION)
+        _check_agent(self.agent, "costs.agent")
+        if self.agent not in ("eig",) and not registry()[self.agent].asks:
+            raise ConfigError(None, "costs.agent", f"{self.agent!r} never asks: nothing to sweep")
+        if any(s <= 0 for s in self.scales) or not self.scales:
+            raise ConfigError(None, "costs.scales", f"scales must be positive, got {list(self.scales)}")
+        if self.samples < 2:
+            raise ConfigError(None, "costs.samples", "must be >= 2")
+
+
+@dataclass(frozen=True)
+class DifficultyConfig:
+    """The difficulty-coefficient ablation and calibration.
+
+    Attributes:
+        alpha: the reference coefficients of (F_distractor, F_room, F_context, F_start); on the simplex.
+        thresholds: the reference bin thresholds of D (easy/medium, medium/hard); 0 <= t0 < t1 <= 1.
+        normalize: rescale an ``alpha`` that does not sum to 1 instead of rejecting it.
+        alpha_step: grid step of the alpha simplex; in (0, 0.5].
+        threshold_step: grid step of the threshold pairs; in (0, 0.5].
+        split_seed: seed of the calibration's fit / held-out split of the episodes.
+        empty: a setting with an empty bin counts as "unordered" or is skipped ("skip").
+    """
+
+    SECTION: ClassVar[str] = "difficulty"
+    alpha: tuple[float, ...] = DIFFICULTY_ALPHA
+    thresholds: tuple[float, ...] = DIFFICULTY_THRESHOLDS
+    normalize: bool = False
+    alpha_step: float = 0.05
+    threshold_step: float = 0.05
+    split_seed: int = 0
+    empty: str = "unordered"
+
+    def __post_init__(self):
+        _check_fields(self, self.SECTION)
+        for key in ("alpha_step", "threshold_step"):
+            v = getattr(self, key)
+            if not 0 < v <= 0.5:
+                raise ConfigError(None, f"difficulty.{key}", f"must be in (0, 0.5], got {v}")
+        object.__setattr__(self, "alpha", tuple(validate_alpha(self.alpha, normalize=self.normalize,
+                                                               where="difficulty.alpha")))
+        object.__setattr__(self, "thresholds", tuple(validate_thresholds(self.thresholds, "difficulty.thresholds")))
+        if self.empty not in ("unordered", "skip"):
+            raise ConfigError(None, "difficulty.empty", "must be 'unordered' or 'skip'")
+
+
+@dataclass(frozen=True)
+class DeriveCostsConfig:
+    """The paper's cost construction from cue statistics (TOML table ``[derive-costs]``).
+
+    Attributes:
+        annotations: cue-annotation JSONL file; empty: the paper's published statistics.
+        assumption: how the published statistics' unpublished cues are completed: "proxy" or "drop".
+        lambdas: weights (lambda_s, lambda_h, lambda_r) of the cue utility; 3 non-negative numbers.
+        fit: also fit the lambdas that best reproduce the locked costs.
+    """
+
+    SECTION: ClassVar[str] = "derive-costs"
+    annotations: str = ""
+    assumption: str = "proxy"
+    lambdas: tuple[float, ...] = (1 / 3, 1 / 3, 1 / 3)
+    fit: bool = True
+
+    def __post_init__(self):
+        _check_fields(self, self.SECTION)
+        if len(self.lambdas) != 3 or any(v < 0 for v in self.lambdas):
+            raise ConfigError(None, "derive-costs.lambdas", f"expected 3 non-negative weights, got {list(self.lambdas)}")
+
+
+@dataclass(frozen=True)
+class AnalysisConfig:
+    """The interaction analyses from one agent's question traces and trajectories.
+
+    Attributes:
+        agent: the agent analysed (also rolled out when not in ``eval.agents``).
+        horizon: matched horizon of Delta-U, planner steps.
+        radius: explored-area radius around the path, m.
+        trajectories: top-down trajectory plots (0: none).
+    """
+
+    SECTION: ClassVar[str] = "analysis"
+    agent: str = "eig"
+    horizon: int = 5
+    radius: float = 1.0
+    trajectories: int = 4
+
+    def __post_init__(self):
+        _check_fields(self, self.SECTION)
+        _check_agent(self.agent, "analysis.agent")
+
+
+@dataclass(frozen=True)
+class SweepConfig:
+    """The whole configuration of a sweep run (one attribute per section).
+
+    Attributes:
+        run: :class:`RunConfig`.
+        benchmark: :class:`BenchmarkConfig`.
+        eval: :class:`EvalConfig`.
+        costs: :class:`CostsConfig`.
+        difficulty: :class:`DifficultyConfig`.
+        derive_costs: :class:`DeriveCostsConfig` (TOML table ``[derive-costs]``).
+        analysis: :class:`AnalysisConfig`.
+        sim: the simulator's :class:`ignjax.sim.types.SimConfig`.
+    """
+
+    run: RunConfig = dataclasses.field(default_factory=RunConfig)
+    benchmark: BenchmarkConfig = dataclasses.field(default_factory=BenchmarkConfig)
+    eval: EvalConfig = dataclasses.field(default_factory=EvalConfig)
+    costs: CostsConfig = dataclasses.field(default_factory=CostsConfig)
+    difficulty: DifficultyConfig = dataclasses.field(default_factory=DifficultyConfig)
+    derive_costs: DeriveCostsConfig = dataclasses.field(default_factory=DeriveCostsConfig)
+    analysis: AnalysisConfig = dataclasses.field(default_factory=AnalysisConfig)
+    sim: SimConfig = dataclasses.field(default_factory=SimConfig)
+
+    def __post_init__(self):
+        for f in dataclasses.fields(self):
+            cls = SECTIONS[_TOML_NAME[f.name]]
+            if not isinstance(getattr(self, f.name), cls):
+                raise ConfigError(None, _TOML_NAME[f.name], f"must be a {cls.__name__}, got {getattr(self, f.name)!r}")
+
+    def to_dict(self) -> dict[str, dict[str, Any]]:
+        """``TOML table -> key -> value`` (lists for tuples): ``run.json``'s ``config``."""
+        return {name: {k: list(v) if isinstance(v, tuple) else v for k, v in dataclasses.asdict(section).items()}
+                for name, section in self.sections().items()}
+
+    def sections(self) -> dict[str, Any]:
+        """``TOML table name -> section object``, in file order."""
+        return {_TOML_NAME[f.name]: getattr(self, f.name) for f in dataclasses.fields(self)}
+
+    @classmethod
+    def from_dict(cls, data: dict[str, dict[str, Any]]) -> "SweepConfig":
+        """Build from ``TOML table -> key -> value`` (missing keys take their defaults)."""
+        for name, items in data.items():
+            _check_names(name, items, "dict")
+        return cls(**{_ATTR_NAME[name]: SECTIONS[name](**data.get(name, {})) for name in SECTIONS})
+
+
+SECTIONS: dict[str, type] = {
+    "run": RunConfig, "benchmark": BenchmarkConfig, "eval": EvalConfig, "costs": CostsConfig,
+    "difficulty": DifficultyConfig, "derive-costs": DeriveCostsConfig, "analysis": AnalysisConfig, "sim": SimConfig,
 }
+"""TOML table name -> section class, in file order."""
+_ATTR_NAME = {name: name.replace("-", "_") for name in SECTIONS}
+_TOML_NAME = {attr: name for name, attr in _ATTR_NAME.items()}
 
 QUICK: dict[str, dict[str, Any]] = {
     "benchmark": {"limit": 60},
@@ -80,64 +356,46 @@ QUICK: dict[str, dict[str, Any]] = {
     "difficulty": {"alpha_step": 0.1, "threshold_step": 0.1},
     "analysis": {"trajectories": 2},
 }
+"""The sizes ``--quick`` replaces (CI and smoke runs)."""
 
 
-def _line_of(text: str, key: str) -> int | None:
+@functools.cache
+def _defaults(section: str) -> dict[str, Any]:
+    """``key -> default value`` of a section (the types its values are checked against)."""
+    d = SECTIONS[section]()
+    return {f.name: getattr(d, f.name) for f in dataclasses.fields(d)}
+
+
+def _check_names(section: str, items: Any, where: str, text: str | None = None) -> None:
+    if section not in SECTIONS:
+        line = _line_of(text, section) if text else None
+        raise ConfigError(f"{where}:{line}" if line else where, section, f"unknown section; known: {', '.join(SECTIONS)}")
+    if not isinstance(items, dict):
+        raise ConfigError(where, section, "must be a table of settings")
+    for key in items:
+        if key not in _defaults(section):
+            line = _line_of(text, section, key) if text else None
+            raise ConfigError(f"{where}:{line}" if line else where, f"{section}.{key}",
+                              f"unknown key; known: {', '.join(_defaults(section))}")
+
+
+# ---------------------------------------------------------------------------
+# TOML files, --set items, resolution
+# ---------------------------------------------------------------------------
+
+
+def _line_of(text: str, section: str, key: str | None = None) -> int | None:
+    """Line (1-based) of ``[section]``, or of ``key = ...`` inside it."""
+    inside = False
     for i, line in enumerate(text.splitlines(), 1):
-        if line.strip().startswith(key):
+        s = line.strip()
+        if s.startswith("["):
+            inside = s.split("#", 1)[0].strip() == f"[{section}]"
+            if inside and key is None:
+                return i
+        elif inside and key is not None and s.split("=", 1)[0].strip().strip('"\'') == key:
             return i
     return None
-
-
-def _check_value(section: str, key: str, value: Any, where: str) -> Any:
-    default = DEFAULTS[section][key]
-    if isinstance(default, bool):
-        if not isinstance(value, bool):
-            raise ConfigError(where, f"{section}.{key}", f"expected true or false, got {value!r}")
-        return value
-    if isinstance(default, int):
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise ConfigError(where, f"{section}.{key}", f"expected an integer, got {value!r}")
-        return value
-    if isinstance(default, float):
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise ConfigError(where, f"{section}.{key}", f"expected a finite number, got {value!r}")
-        return float(value)
-    if isinstance(default, str):
-        if not isinstance(value, str):
-            raise ConfigError(where, f"{section}.{key}", f"expected a string, got {value!r}")
-        return value
-    if isinstance(default, list):
-        if not isinstance(value, list):
-            raise ConfigError(where, f"{section}.{key}", f"expected a list, got {value!r}")
-        if default and isinstance(default[0], (int, float)) and not isinstance(default[0], bool):
-            for v in value:
-                if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-                    raise ConfigError(where, f"{section}.{key}", f"expected finite numbers, got {value!r}")
-            return [float(v) for v in value]
-        if default and isinstance(default[0], str) and not all(isinstance(v, str) for v in value):
-            raise ConfigError(where, f"{section}.{key}", f"expected strings, got {value!r}")
-        return list(value)
-    return value
-
-
-def merge(config: dict, overrides: dict, where: str, text: str | None = None) -> dict:
-    """Apply a ``section -> key -> value`` mapping, checking names and types."""
-    out = copy.deepcopy(config)
-    for section, items in overrides.items():
-        if section not in DEFAULTS:
-            line = _line_of(text, f"[{section}]") if text else None
-            loc = f"{where}:{line}" if line else where
-            raise ConfigError(loc, section, f"unknown section; known: {', '.join(DEFAULTS)}")
-        if not isinstance(items, dict):
-            raise ConfigError(where, section, "must be a table of settings")
-        for key, value in items.items():
-            if key not in DEFAULTS[section]:
-                line = _line_of(text, key) if text else None
-                loc = f"{where}:{line}" if line else where
-                raise ConfigError(loc, f"{section}.{key}", f"unknown key; known: {', '.join(DEFAULTS[section])}")
-            out[section][key] = _check_value(section, key, value, where)
-    return out
 
 
 def load_toml(path: str | os.PathLike) -> tuple[dict, str]:
@@ -163,75 +421,125 @@ def parse_set(item: str) -> dict:
         value = tomllib.loads(f"v = {raw}")["v"]
     except tomllib.TOMLDecodeError:
         value = raw
-    if section not in DEFAULTS:
-        raise ConfigError(None, "--set", f"unknown section {section!r}; known: {', '.join(DEFAULTS)}")
-    if key not in DEFAULTS[section]:
-        raise ConfigError(None, "--set", f"unknown key {section}.{key}; known: {', '.join(DEFAULTS[section])}")
+    if section not in SECTIONS:
+        raise ConfigError(None, "--set", f"unknown section {section!r}; known: {', '.join(SECTIONS)}")
+    if key not in _defaults(section):
+        raise ConfigError(None, "--set", f"unknown key {section}.{key}; known: {', '.join(_defaults(section))}")
     return {section: {key: value}}
 
 
-def resolve(config_file: str | None = None, sets: list[str] = (), quick: bool = False) -> dict:
-    """Defaults <- quick sizes <- TOML file <- ``--set`` items (later wins)."""
-    cfg = copy.deepcopy(DEFAULTS)
+def resolve(config_file: str | os.PathLike | None = None, sets: list[str] = (), quick: bool = False) -> SweepConfig:
+    """Defaults <- quick sizes <- TOML file <- ``--set`` items (later wins).
+
+    Names and types are checked as each layer is applied, the values' meaning
+    once all are (a later layer may repair an earlier one's value); every
+    error names where the offending key was set (``file:line``, ``--set`` or
+    ``quick``) and the key.
+    """
+    values: dict[str, dict[str, Any]] = {name: {} for name in SECTIONS}
+    origin: dict[str, str] = {}
+
+    def apply(overrides: dict, where: str, text: str | None = None) -> None:
+        for section, items in overrides.items():
+            _check_names(section, items, where, text)
+            for key, value in items.items():
+                line = _line_of(text, section, key) if text else None
+                loc = f"{where}:{line}" if line else where
+                values[section][key] = _check_value(f"{section}.{key}", value, _defaults(section)[key], loc)
+                origin[f"{section}.{key}"] = loc
+
     if quick:
-        cfg = merge(cfg, QUICK, "quick")
+        apply(QUICK, "quick")
     if config_file:
         data, text = load_toml(config_file)
-        cfg = merge(cfg, data, str(config_file), text)
+        apply(data, str(config_file), text)
     for item in sets:
-        cfg = merge(cfg, parse_set(item), "--set")
-    validate(cfg)
-    return cfg
+        apply(parse_set(item), "--set")
+    try:
+        return SweepConfig.from_dict(values)
+    except ConfigError as e:
+        loc = origin.get(e.where.split("[", 1)[0])
+        if loc and not e.path:
+            raise ConfigError(loc, e.where, e.reason) from None
+        raise
 
 
-def validate(cfg: dict) -> None:
-    """Semantic checks that must fail before any work starts."""
-    from ignjax.agents.base import registry
-
-    known = registry()
-    for name in cfg["eval"]["agents"] + [cfg["costs"]["agent"], cfg["analysis"]["agent"]]:
-        if name not in known:
-            raise ConfigError(None, "agent", f"unknown agent {name!r}; known: {', '.join(known)}")
-    if not cfg["eval"]["agents"]:
-        raise ConfigError(None, "eval.agents", "must name at least one agent")
-    costs = cfg["eval"]["costs"]
-    from ignjax.studies.cost_sensitivity import validate_costs
-
-    if len(costs) != 4:
-        raise ConfigError(None, "eval.costs", f"expected 4 costs (one per question type), got {costs}")
-    validate_costs(costs, "eval.costs")
-    if cfg["costs"]["agent"] not in ("eig",) and not known[cfg["costs"]["agent"]].asks:
-        raise ConfigError(None, "costs.agent", f"{cfg['costs']['agent']!r} never asks: nothing to sweep")
-    if any(s <= 0 for s in cfg["costs"]["scales"]) or not cfg["costs"]["scales"]:
-        raise ConfigError(None, "costs.scales", f"scales must be positive, got {cfg['costs']['scales']}")
-    if cfg["costs"]["samples"] < 2:
-        raise ConfigError(None, "costs.samples", "must be >= 2")
-    for key in ("alpha_step", "threshold_step"):
-        v = cfg["difficulty"][key]
-        if not 0 < v <= 0.5:
-            raise ConfigError(None, f"difficulty.{key}", f"must be in (0, 0.5], got {v}")
-    from ignjax.episodes.difficulty import validate_alpha, validate_thresholds
-
-    cfg["difficulty"]["alpha"] = list(validate_alpha(cfg["difficulty"]["alpha"], normalize=cfg["difficulty"]["normalize"],
-                                                     where="difficulty.alpha"))
-    cfg["difficulty"]["thresholds"] = list(validate_thresholds(cfg["difficulty"]["thresholds"], "difficulty.thresholds"))
-    if cfg["difficulty"]["empty"] not in ("unordered", "skip"):
-        raise ConfigError(None, "difficulty.empty", "must be 'unordered' or 'skip'")
-    if cfg["eval"]["batch"] < 1:
-        raise ConfigError(None, "eval.batch", "must be >= 1")
-    if cfg["eval"]["parts"] < 0:
-        raise ConfigError(None, "eval.parts", f"must be >= 0 (0: the default split), got {cfg['eval']['parts']}")
-    if sorted(cfg["eval"]["thresholds"]) != cfg["eval"]["thresholds"] or any(t <= 0 for t in cfg["eval"]["thresholds"]):
-        raise ConfigError(None, "eval.thresholds", "must be positive and increasing")
-    lam = cfg["derive-costs"]["lambdas"]
-    if len(lam) != 3 or any(v < 0 for v in lam):
-        raise ConfigError(None, "derive-costs.lambdas", f"expected 3 non-negative weights, got {lam}")
+def digest(obj: Any) -> str:
+    """16 hex digits of the SHA-256 of ``obj``'s canonical JSON."""
+    return hashlib.sha256(json.dumps(obj, sort_keys=True).encode()).hexdigest()[:16]
 
 
-def fingerprint(cfg: dict, studies: list[str]) -> str:
-    """Hash of what determines a run's outputs (config + studies)."""
-    blob = json.dumps({"config": cfg, "studies": studies}, sort_keys=True).encode()
-    return hashlib.sha256(blob).hexdigest()[:16]
+def fingerprint(cfg: SweepConfig, studies: list[str]) -> str:
+    """Hash of what determines a run's outputs (configuration + studies)."""
+    return digest({"config": cfg.to_dict(), "studies": list(studies)})
 
 
-__all__ = ["DEFAULTS", "QUICK", "STUDIES", "fingerprint", "load_toml", "merge", "parse_set", "resolve", "validate"]
+# ---------------------------------------------------------------------------
+# the configuration as TOML (sweeps/default.toml)
+# ---------------------------------------------------------------------------
+
+
+def field_docs(cls: type) -> dict[str, str]:
+    """``field -> description`` from the ``Attributes:`` section of ``cls``'s docstring."""
+    docs: dict[str, str] = {}
+    lines = (cls.__doc__ or "").splitlines()
+    try:
+        start = next(i for i, line in enumerate(lines) if line.strip() == "Attributes:")
+    except StopIteration:
+        return docs
+    indent, name = None, None
+    for line in lines[start + 1:]:
+        if not line.strip():
+            break
+        depth = len(line) - len(line.lstrip())
+        indent = depth if indent is None else indent
+        if depth < indent:
+            break
+        if depth == indent and ":" in line:
+            name, text = line.strip().split(":", 1)
+            docs[name] = text.strip()
+        elif name is not None:
+            docs[name] += " " + line.strip()
+    return docs
+
+
+def _toml_value(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, float)):
+        return repr(v)
+    if isinstance(v, str):
+        return json.dumps(v)
+    return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+
+
+def to_toml(cfg: SweepConfig, header: str = "") -> str:
+    """``cfg`` as a TOML file: every table and key, each key under its description."""
+    out = [f"# {line}".rstrip() for line in header.splitlines()]
+    for name, section in cfg.sections().items():
+        docs = field_docs(type(section))
+        if out:
+            out.append("")
+        out.append(f"[{name}]")
+        for f in dataclasses.fields(section):
+            out += textwrap.wrap(docs.get(f.name, "").replace("``", "`"), 110, initial_indent="# ", subsequent_indent="# ")
+            out.append(f"{f.name} = {_toml_value(getattr(section, f.name))}")
+    return "\n".join(out) + "\n"
+
+
+DEFAULT_TOML_HEADER = """\
+The default study of `python -m ignjax.sweep`: every key with its default value and what it means.
+Any key may be left out; `--set section.key=value` overrides one on the command line.
+Generated by ignjax.config.default_toml() (tests/sweep/test_sweep.py checks that this file matches it)."""
+
+
+def default_toml() -> str:
+    """The text of ``sweeps/default.toml``: :func:`to_toml` of the defaults."""
+    return to_toml(SweepConfig(), DEFAULT_TOML_HEADER)
+
+
+__all__ = [
+    "AnalysisConfig", "BenchmarkConfig", "CostsConfig", "DeriveCostsConfig", "DifficultyConfig", "EvalConfig", "QUICK",
+    "RunConfig", "SECTIONS", "SweepConfig", "default_toml", "digest", "field_docs", "fingerprint", "load_toml",
+    "parse_set", "resolve", "to_toml",
+]

@@ -2,6 +2,6 @@
 
 import sys
 
-from ignjax.sweep.runner import main
+from ignjax.sweep.cli import main
 
 sys.exit(main())

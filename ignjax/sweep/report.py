@@ -1,4 +1,4 @@
-"""Studies' tables, figures and ``report.md`` of a sweep run (:mod:`ignjax.sweep.runner`).
+"""Studies' tables, figures and ``report.md`` of a sweep run (:mod:`ignjax.sweep.stages`).
 
 Everything here is a deterministic function of the rollouts and the
 configuration, so an interrupted-and-resumed run writes the same bytes as
@@ -14,22 +14,31 @@ import math
 from pathlib import Path
 from types import SimpleNamespace
 
+import matplotlib.pyplot as plt
 import numpy as np
 
+from ignjax.config import SweepConfig
 from ignjax.evaluate import metrics as M
-from ignjax.episodes.difficulty import BIN_INDEX, BIN_NAMES
+from ignjax.evaluate.outcomes import metric_rows, outcome_rows, write_metric_table, write_outcomes
 from ignjax.fileio import atomic_write
-
-FACTOR_NAMES = ("F_distractor", "F_room", "F_context", "F_start")
+from ignjax.protocol import BIN_INDEX, BIN_NAMES, FACTOR_NAMES
+from ignjax.scenes.viz.mapplot import plot_scene_map, save_figure
+from ignjax.studies import cost_derivation as C
+from ignjax.studies import cost_sensitivity as CS
+from ignjax.studies import difficulty_ablation as DA
+from ignjax.studies import interaction as IA
+from ignjax.studies._common import new_figure, save
 
 
 def _fmt(v) -> str:
+    """A CSV cell: floats to 6 significant digits (``nan`` when not finite)."""
     if isinstance(v, (float, np.floating)):
         return "nan" if not math.isfinite(float(v)) else f"{float(v):.6g}"
     return str(v)
 
 
 def write_csv(path: Path, header: list[str], rows: list[list]) -> Path:
+    """Write a study's table as CSV (atomically); markdown tables are :func:`ignjax.evaluate.metrics.md_table`."""
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(header)
@@ -38,31 +47,18 @@ def write_csv(path: Path, header: list[str], rows: list[list]) -> Path:
     return atomic_write(path, buf.getvalue())
 
 
-def md_table(header: list[str], rows: list[list]) -> str:
-    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
-    def cell(v):
-        if isinstance(v, str):
-            return v
-        if isinstance(v, (float, np.floating)):
-            return "nan" if not math.isfinite(float(v)) else f"{float(v):.4g}"
-        return str(v)
-
-    lines += ["| " + " | ".join(cell(v) for v in r) + " |" for r in rows]
-    return "\n".join(lines)
-
-
 # ---------------------------------------------------------------------------
 # inputs from rollouts
 # ---------------------------------------------------------------------------
 
 
-def agent_arrays(es, rollouts: dict, cfg: dict) -> dict:
+def agent_arrays(es, rollouts: dict, cfg: SweepConfig) -> dict:
     """Stacked per-agent arrays: success (A, E, T), n_questions (A, E, 4), valid, difficulty."""
     names = list(rollouts)
     outs = [rollouts[a]["out"] for a in names]
     fd = np.stack([np.asarray(o["final_distance"]) for o in outs])
     stopped = np.stack([np.asarray(o["stopped"]) for o in outs])
-    success = np.asarray(M.episode_success(fd, stopped, tuple(cfg["eval"]["thresholds"]), cfg["eval"]["require_stop"]))
+    success = np.asarray(M.episode_success(fd, stopped, tuple(cfg.eval.thresholds), cfg.eval.require_stop))
     nq = np.stack([np.asarray(o["n_questions"]) for o in outs]).astype(np.int64)
     difficulty = np.array([BIN_INDEX[r["difficulty"]] for r in es.records], np.int64)
     return {"names": names, "success": success, "n_questions": nq, "valid": np.ones(fd.shape, bool),
@@ -78,30 +74,42 @@ def factors_of(es) -> np.ndarray:
 # ---------------------------------------------------------------------------
 
 
-def study_eval(es, rollouts: dict, cfg: dict, out: Path) -> dict:
-    from ignjax.evaluate.outcomes import metric_rows, outcome_rows, write_metric_table, write_outcomes
-
+def study_eval(es, rollouts: dict, cfg: SweepConfig, out: Path) -> dict:
     rows = []
     for name, tree in rollouts.items():
-        if name not in cfg["eval"]["agents"]:
+        if name not in cfg.eval.agents:
             continue
         rows += outcome_rows(name, es.records, SimpleNamespace(**tree["out"]))
     write_outcomes(rows, out)
-    metrics = metric_rows(rows, tuple(cfg["eval"]["thresholds"]), tuple(cfg["eval"]["costs"]), cfg["eval"]["require_stop"])
+    metrics = metric_rows(rows, tuple(cfg.eval.thresholds), tuple(cfg.eval.costs), cfg.eval.require_stop)
     write_metric_table(metrics, out / "metrics.csv")
     return {"rows": rows, "metrics": metrics}
 
 
-def study_costs(es, rollouts: dict, in_loop: dict | None, cfg: dict, out: Path) -> dict:
-    from ignjax.studies import cost_sensitivity as CS
-    from ignjax.sweep.runner import in_loop_costs
+def in_loop_costs(cfg: SweepConfig) -> tuple[np.ndarray, list[str]]:
+    """(K, 4) cost vectors of the in-the-loop study and their labels."""
+    locked = np.asarray(cfg.eval.costs, np.float64)
+    vecs, labels = [], []
+    for s in cfg.costs.scales:
+        vecs.append(locked * s)
+        labels.append(f"all x{s:g}")
+    f = cfg.costs.per_type_factor
+    if f > 0:
+        for t in range(4):
+            v = locked.copy()
+            v[t] *= f
+            vecs.append(v)
+            labels.append(f"Type {t + 1} x{f:g}")
+    return np.asarray(vecs), labels
 
-    arr = agent_arrays(es, {a: rollouts[a] for a in cfg["eval"]["agents"]}, cfg)
-    locked = np.asarray(cfg["eval"]["costs"], np.float64)
+
+def study_costs(es, rollouts: dict, in_loop: dict | None, cfg: SweepConfig, out: Path) -> dict:
+    arr = agent_arrays(es, {a: rollouts[a] for a in cfg.eval.agents}, cfg)
+    locked = np.asarray(cfg.eval.costs, np.float64)
     total = float(locked.sum())
     include = np.stack([locked, np.full(4, total / 4)])
-    costs = CS.cost_samples(int(cfg["costs"]["samples"]), int(cfg["costs"]["seed"]), total=total, include=include)
-    ti = cfg["eval"]["thresholds"].index(1.5) if 1.5 in cfg["eval"]["thresholds"] else None
+    costs = CS.cost_samples(int(cfg.costs.samples), int(cfg.costs.seed), total=total, include=include)
+    ti = cfg.eval.thresholds.index(1.5) if 1.5 in cfg.eval.thresholds else None
     res = CS.run_study(arr["success"], arr["n_questions"], arr["valid"], costs, agent_names=arr["names"],
                        threshold_index=ti)
     fig = out / "figures"
@@ -120,8 +128,8 @@ def study_costs(es, rollouts: dict, in_loop: dict | None, cfg: dict, out: Path) 
         o = in_loop["out"]
         fd, stopped = np.asarray(o["final_distance"]), np.asarray(o["stopped"])  # (K, E)
         nq = np.asarray(o["n_questions"]).astype(np.float64)  # (K, E, 4)
-        thr = 1.5 if 1.5 in cfg["eval"]["thresholds"] else cfg["eval"]["thresholds"][0]
-        succ = np.asarray(M.episode_success(fd, stopped, (thr,), cfg["eval"]["require_stop"]))[..., 0]
+        thr = 1.5 if 1.5 in cfg.eval.thresholds else cfg.eval.thresholds[0]
+        succ = np.asarray(M.episode_success(fd, stopped, (thr,), cfg.eval.require_stop))[..., 0]
         disc = np.exp(-np.einsum("ket,kt->ke", nq, vecs))
         lrows = []
         for k, lab in enumerate(labels):
@@ -132,15 +140,13 @@ def study_costs(es, rollouts: dict, in_loop: dict | None, cfg: dict, out: Path) 
         write_csv(out / "costs_in_loop.csv", lheader, lrows)
         _plot_in_loop(cfg, vecs, labels, nq, succ, disc, fig / "costs_in_loop.png")
         summary["in_loop_table"] = (lheader, lrows)
-        summary["in_loop_agent"] = cfg["costs"]["agent"]
+        summary["in_loop_agent"] = cfg.costs.agent
     return summary
 
 
-def _plot_in_loop(cfg, vecs, labels, nq, succ, disc, path):
-    from ignjax.studies._common import new_figure, save
-
-    n_s = len(cfg["costs"]["scales"])
-    scales = np.asarray(cfg["costs"]["scales"])
+def _plot_in_loop(cfg: SweepConfig, vecs, labels, nq, succ, disc, path):
+    n_s = len(cfg.costs.scales)
+    scales = np.asarray(cfg.costs.scales)
     fig, axs = new_figure(1, 2, size=(11.0, 4.0))
     ax = axs[0, 0]
     for t in range(4):
@@ -149,7 +155,7 @@ def _plot_in_loop(cfg, vecs, labels, nq, succ, disc, path):
     ax.set_xscale("log")
     ax.set_xlabel("cost scale (x locked costs)")
     ax.set_ylabel("questions per episode")
-    ax.set_title(f"{cfg['costs']['agent']}: asking vs charged costs")
+    ax.set_title(f"{cfg.costs.agent}: asking vs charged costs")
     ax.legend(fontsize=8)
     ax = axs[0, 1]
     ax.plot(scales, 100 * succ[:n_s].mean(-1), marker="o", label="SR@1.5")
@@ -162,23 +168,21 @@ def _plot_in_loop(cfg, vecs, labels, nq, succ, disc, path):
     save(fig, path)
 
 
-def study_difficulty(es, rollouts: dict, cfg: dict, out: Path) -> dict:
-    from ignjax.studies import difficulty_ablation as DA
-
-    arr = agent_arrays(es, {a: rollouts[a] for a in cfg["eval"]["agents"]}, cfg)
-    ti = cfg["eval"]["thresholds"].index(1.5) if 1.5 in cfg["eval"]["thresholds"] else 0
+def study_difficulty(es, rollouts: dict, cfg: SweepConfig, out: Path) -> dict:
+    arr = agent_arrays(es, {a: rollouts[a] for a in cfg.eval.agents}, cfg)
+    ti = cfg.eval.thresholds.index(1.5) if 1.5 in cfg.eval.thresholds else 0
     success = arr["success"][..., ti]
     factors = factors_of(es)
-    alphas = DA.alpha_grid(cfg["difficulty"]["alpha_step"])
-    thresholds = DA.threshold_grid(cfg["difficulty"]["threshold_step"])
+    alphas = DA.alpha_grid(cfg.difficulty.alpha_step)
+    thresholds = DA.threshold_grid(cfg.difficulty.threshold_step)
     # the reference setting (difficulty.alpha / thresholds) is added to the grids so it is always evaluated
-    d_alpha = np.asarray(cfg["difficulty"]["alpha"], np.float64)
-    d_thr = np.asarray(cfg["difficulty"]["thresholds"], np.float64)
+    d_alpha = np.asarray(cfg.difficulty.alpha, np.float64)
+    d_thr = np.asarray(cfg.difficulty.thresholds, np.float64)
     alphas = np.concatenate([d_alpha[None], alphas])
     thresholds = np.concatenate([d_thr[None], thresholds])
-    abl = DA.ablate(factors, success, None, alphas, thresholds, empty=cfg["difficulty"]["empty"])
+    abl = DA.ablate(factors, success, None, alphas, thresholds, empty=cfg.difficulty.empty)
     gi, hi = 0, 0
-    cal = DA.calibrate(factors, 1.0 - success, None, alphas[1:], cfg["difficulty"]["split_seed"])
+    cal = DA.calibrate(factors, 1.0 - success, None, alphas[1:], cfg.difficulty.split_seed)
     fig = out / "figures"
     DA.plot_ordering(abl, fig / "difficulty_ordering.png")
     DA.plot_calibration(cal, fig / "difficulty_calibration.png")
@@ -193,19 +197,17 @@ def study_difficulty(es, rollouts: dict, cfg: dict, out: Path) -> dict:
             "default_proportions": abl["proportions"][gi, hi], "n_settings": int(abl["ordered"].size)}
 
 
-def study_derive_costs(cfg: dict, out: Path) -> dict:
-    from ignjax.studies import cost_derivation as C
-
-    dc = cfg["derive-costs"]
-    if dc["annotations"]:
-        stats = C.statistics_from_annotations(dc["annotations"])
-        source = f"annotations {dc['annotations']}"
+def study_derive_costs(cfg: SweepConfig, out: Path) -> dict:
+    dc = cfg.derive_costs
+    if dc.annotations:
+        stats = C.statistics_from_annotations(dc.annotations)
+        source = f"annotations {dc.annotations}"
     else:
-        stats = C.published_statistics(dc["assumption"])
-        source = f"published statistics (assumption: {dc['assumption']})"
-    locked = tuple(cfg["eval"]["costs"])
-    derived = C.derive_costs(stats, tuple(dc["lambdas"]), locked=locked)
-    fitted = C.fit_lambdas(stats, locked=locked) if dc["fit"] else None
+        stats = C.published_statistics(dc.assumption)
+        source = f"published statistics (assumption: {dc.assumption})"
+    locked = tuple(cfg.eval.costs)
+    derived = C.derive_costs(stats, tuple(dc.lambdas), locked=locked)
+    fitted = C.fit_lambdas(stats, locked=locked) if dc.fit else None
     header = ["setting", "lambda_s", "lambda_h", "lambda_r", "w1", "w2", "w3", "w4", "ordering", "rmse to locked"]
     rows = [["locked", "", "", ""] + list(locked) + ["".join(str(t) for t in C._ordering(locked)), 0.0]]
     for name, d in (("given lambdas", derived), ("fitted lambdas", fitted)):
@@ -215,10 +217,8 @@ def study_derive_costs(cfg: dict, out: Path) -> dict:
     return {"source": source, "table": (header, rows), "assumed": list(getattr(stats, "assumed", []) or [])}
 
 
-def study_analysis(es, rollouts: dict, cfg: dict, out: Path) -> dict:
-    from ignjax.studies import interaction as IA
-
-    agent = cfg["analysis"]["agent"]
+def study_analysis(es, rollouts: dict, cfg: SweepConfig, out: Path) -> dict:
+    agent = cfg.analysis.agent
     tree = rollouts[agent]
     traj = SimpleNamespace(**tree["traj"])
     diff = np.array([BIN_INDEX[r["difficulty"]] for r in es.records], np.int64)
@@ -229,7 +229,7 @@ def study_analysis(es, rollouts: dict, cfg: dict, out: Path) -> dict:
     scene_index = np.asarray(es.specs.scene)
     loc = IA.type3_locations(grids, np.asarray(traj.pose), events, scene_index=scene_index, room_labels=labels)
     qpd = IA.questions_per_difficulty(np.asarray(tree["out"]["n_questions"]), diff)
-    du = IA.delta_u(np.asarray(traj.pose), events, h=int(cfg["analysis"]["horizon"]), r=float(cfg["analysis"]["radius"]))
+    du = IA.delta_u(np.asarray(traj.pose), events, h=int(cfg.analysis.horizon), r=float(cfg.analysis.radius))
     fig = out / "figures"
     IA.plot_question_timing(timing, fig / "analysis_timing.png")
     IA.plot_location_classes(loc, fig / "analysis_type3_locations.png")
@@ -243,7 +243,7 @@ def study_analysis(es, rollouts: dict, cfg: dict, out: Path) -> dict:
     lheader = ["class", "Type-3 questions", "share"]
     lrows = [[c, int(n), float(f)] for c, n, f in zip(loc["classes"], loc["counts"], loc["fractions"])]
     write_csv(out / "analysis_type3_locations.csv", lheader, lrows)
-    plots = plot_trajectories(es, tree, int(cfg["analysis"]["trajectories"]), fig, agent)
+    plots = plot_trajectories(es, tree, int(cfg.analysis.trajectories), fig, agent)
     return {"agent": agent, "per_difficulty": (header, rows), "locations": (lheader, lrows), "timing": timing,
             "trajectory_plots": plots}
 
@@ -255,10 +255,6 @@ def plot_trajectories(es, tree: dict, n: int, folder: Path, agent: str) -> list[
     """Top-down plots of a few episodes (one per difficulty first, then in
     file order): start, path, target, distractors and where each question
     type was asked."""
-    import matplotlib.pyplot as plt
-
-    from ignjax.scenes.viz.mapplot import plot_scene_map, save_figure
-
     if n <= 0:
         return []
     diff = [r["difficulty"] for r in es.records]
@@ -310,23 +306,24 @@ def plot_trajectories(es, tree: dict, n: int, folder: Path, agent: str) -> list[
 
 
 def write_outputs(results: dict, out: Path) -> None:
+    """Run the table-and-figure part of each study in ``results["studies"]`` and write ``report.md``."""
     cfg, studies = results["config"], results["studies"]
     es = results.get("episodes")
     rollouts = results.get("rollouts", {})
-    parts = [f"# ignjax sweep: {cfg['run']['name']}", ""]
+    parts = [f"# ignjax sweep: {cfg.run.name}", ""]
     if es is not None:
         counts = {b: sum(r["difficulty"] == b for r in es.records) for b in BIN_NAMES}
         parts += [f"Benchmark: {len(es)} episodes in {len(es.bank.scene_ids)} scenes "
-                  f"({', '.join(f'{counts[b]} {b}' for b in BIN_NAMES)}); seed {cfg['run']['seed']}; "
-                  f"locked costs {tuple(cfg['eval']['costs'])}; success = geodesic distance <= threshold"
-                  f"{' and STOP' if cfg['eval']['require_stop'] else ''}.", ""]
+                  f"({', '.join(f'{counts[b]} {b}' for b in BIN_NAMES)}); seed {cfg.run.seed}; "
+                  f"locked costs {tuple(cfg.eval.costs)}; success = geodesic distance <= threshold"
+                  f"{' and STOP' if cfg.eval.require_stop else ''}.", ""]
     if "eval" in studies:
         ev = study_eval(es, rollouts, cfg, out)
         results["eval"] = ev
         parts += ["## Evaluation (Table-1 columns)", "",
                   "SR/OSR and WSR in %, NE and TL in metres, Q_t questions per episode; the Easy/Medium/Hard columns "
                   "repeat SR@1.5, WSR@1.5 and |Q| per difficulty. `shortest_path` is privileged (an upper bound).", ""]
-        if all(t in cfg["eval"]["thresholds"] for t in (0.5, 1.5, 3.0)):
+        if all(t in cfg.eval.thresholds for t in (0.5, 1.5, 3.0)):
             parts += [M.table1(ev["metrics"], "markdown"), ""]
         parts += ["Per-episode outcomes: `outcomes.parquet`, `outcomes.csv`; metrics: `metrics.csv`.", ""]
     if "costs" in studies:
@@ -337,7 +334,7 @@ def write_outputs(results: dict, out: Path) -> None:
         parts += ["## Cost-weight sensitivity", "",
                   f"Offline: the stored outcomes re-weighted under {len(res['costs'])} cost vectors (row 0 locked, "
                   f"row 1 uniform, the rest uniform on the simplex scaled to the locked sum). WSR@1.5 in %.", "",
-                  md_table(cs["offline_table"][0], [[r[0]] + [100 * v if i < 5 else v for i, v in enumerate(r[1:])]
+                  M.md_table(cs["offline_table"][0], [[r[0]] + [100 * v if i < 5 else v for i, v in enumerate(r[1:])]
                                                     for r in cs["offline_table"][1]]), "",
                   f"The ranking differs from the locked-cost ranking for {100 * fl['fraction_flipped']:.1f}% of the "
                   f"cost vectors (mean Kendall tau {fl['tau_mean']:.3f}, min {fl['tau_min']:.3f}). Mean costs where "
@@ -349,7 +346,7 @@ def write_outputs(results: dict, out: Path) -> None:
             h, rows = cs["in_loop_table"]
             parts += [f"In the loop: `{cs['in_loop_agent']}` re-run under each charged cost vector (one vmapped call "
                       "over cost vectors x episodes). Its asking should fall as costs rise.", "",
-                      md_table(h, rows), "", "![Asking vs costs](figures/costs_in_loop.png)", ""]
+                      M.md_table(h, rows), "", "![Asking vs costs](figures/costs_in_loop.png)", ""]
     if "difficulty" in studies:
         ds = study_difficulty(es, rollouts, cfg, out)
         results["difficulty"] = ds
@@ -359,13 +356,13 @@ def write_outputs(results: dict, out: Path) -> None:
                   f"{len(abl['alphas'])} alpha settings on the simplex x {len(abl['thresholds'])} threshold pairs "
                   f"({ds['n_settings']} settings), on the stored factors. Per-bin SR is ordered easy >= medium >= hard "
                   f"for every agent in {100 * abl['fraction_ordered']:.1f}% of the settings "
-                  f"(empty-bin rule: {cfg['difficulty']['empty']}). The reference alpha {tuple(cfg['difficulty']['alpha'])} and "
-                  f"thresholds {tuple(cfg['difficulty']['thresholds'])} give bins "
+                  f"(empty-bin rule: {cfg.difficulty.empty}). The reference alpha {tuple(cfg.difficulty.alpha)} and "
+                  f"thresholds {tuple(cfg.difficulty.thresholds)} give bins "
                   f"{100 * p[0]:.0f}/{100 * p[1]:.0f}/{100 * p[2]:.0f}% of the episodes.", "",
-                  md_table(*ds["default_bins"]), "", "![Ordering](figures/difficulty_ordering.png)", "",
+                  M.md_table(*ds["default_bins"]), "", "![Ordering](figures/difficulty_ordering.png)", "",
                   "Calibration (alpha maximising the Spearman correlation between D and failure, mean over agents; "
                   "fitted on one half of the episodes, reported on the other):", "",
-                  md_table(*ds["calibration_table"]), "", "![Calibration](figures/difficulty_calibration.png)", ""]
+                  M.md_table(*ds["calibration_table"]), "", "![Calibration](figures/difficulty_calibration.png)", ""]
     if "derive-costs" in studies:
         dc = study_derive_costs(cfg, out)
         results["derive-costs"] = dc
@@ -374,14 +371,14 @@ def write_outputs(results: dict, out: Path) -> None:
                   f"the locked penalty range. Input: {dc['source']}."
                   + (f" Cues with assumed statistics (unpublished): {', '.join(map(str, dc['assumed']))}."
                      if dc["assumed"] else ""), "",
-                  md_table(*dc["table"]), ""]
+                  M.md_table(*dc["table"]), ""]
     if "analysis" in studies:
         an = study_analysis(es, rollouts, cfg, out)
         results["analysis"] = an
         parts += [f"## Interaction analyses (`{an['agent']}`)", "",
-                  md_table(*an["per_difficulty"]), "",
+                  M.md_table(*an["per_difficulty"]), "",
                   "Where Type-3 questions were asked (classified from the navigation grid):", "",
-                  md_table(*an["locations"]), "",
+                  M.md_table(*an["locations"]), "",
                   "![Timing](figures/analysis_timing.png)", "",
                   "![Type-3 locations](figures/analysis_type3_locations.png)", "",
                   "![Questions per difficulty](figures/analysis_questions_per_difficulty.png)", "",
@@ -391,5 +388,5 @@ def write_outputs(results: dict, out: Path) -> None:
     atomic_write(out / "report.md", "\n".join(parts))
 
 
-__all__ = ["agent_arrays", "factors_of", "md_table", "plot_trajectories", "study_analysis", "study_costs",
+__all__ = ["agent_arrays", "factors_of", "in_loop_costs", "plot_trajectories", "study_analysis", "study_costs",
            "study_derive_costs", "study_difficulty", "study_eval", "write_csv", "write_outputs"]

@@ -5,6 +5,7 @@ SIGKILL with identical bytes, and bad input rejected before any work."""
 from __future__ import annotations
 
 import csv
+import dataclasses
 import math
 import os
 import signal
@@ -16,9 +17,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ignjax.config import (CostsConfig, DifficultyConfig, EvalConfig, SweepConfig, default_toml, fingerprint,
+                           parse_set, resolve)
 from ignjax.errors import ConfigError, InputError
-from ignjax.sweep.runner import main, run_sweep
-from ignjax.config import DEFAULTS, parse_set, resolve
+from ignjax.sim.types import SimConfig
+from ignjax.sweep.checkpoints import Checkpoints
+from ignjax.sweep.cli import main
+from ignjax.sweep.stages import run_sweep
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -59,7 +64,7 @@ def test_report_and_tables_are_written(sweep_run):
 def test_wsr_columns_recompute_from_outcomes_alone(sweep_run):
     """metrics.csv's WSR@t equals a plain loop over outcomes.csv rows."""
     out = sweep_run["out"]
-    costs = sweep_run["cfg"]["eval"]["costs"]
+    costs = sweep_run["cfg"].eval.costs
     with open(out / "outcomes.csv") as fh:
         rows = list(csv.DictReader(fh))
     with open(out / "metrics.csv") as fh:
@@ -86,7 +91,7 @@ def test_in_loop_asking_falls_as_costs_rise(sweep_run):
 
 def test_offline_study_reference_rows(sweep_run):
     res = sweep_run["res"]["costs"]["offline"]
-    assert np.allclose(res["costs"][0], DEFAULTS["eval"]["costs"])
+    assert np.allclose(res["costs"][0], SweepConfig().eval.costs)
     assert res["tau"][0] == pytest.approx(1.0)
     metrics = sweep_run["res"]["eval"]["metrics"]
     for a, name in enumerate(res["agent_names"]):  # row 0 (locked costs) reproduces the evaluation's WSR@1.5
@@ -104,7 +109,7 @@ def test_resume_after_sigkill_gives_identical_outputs(sweep_run, small_benchmark
     ck = out / "checkpoints"
     deadline = time.time() + 300
     while time.time() < deadline and proc.poll() is None:
-        if ck.is_dir() and any(p.is_dir() and not p.name.endswith(".partial") for p in ck.iterdir()):
+        if ck.is_dir() and any(p.is_dir() and ".orbax-checkpoint-tmp" not in p.name for p in ck.iterdir()):
             break
         time.sleep(0.2)
     assert proc.poll() is None, "the run ended before it could be interrupted: " + proc.stderr.read().decode()[-2000:]
@@ -158,7 +163,7 @@ def test_set_items_are_checked():
         parse_set("samples")
     with pytest.raises(ConfigError, match="expected an integer"):
         resolve(None, ["costs.samples='many'"])
-    assert resolve(None, ["costs.samples=7"])["costs"]["samples"] == 7
+    assert resolve(None, ["costs.samples=7"]).costs.samples == 7
 
 
 @pytest.mark.parametrize("costs, reason", [("[-0.1, 0.1, 0.1, 0.1]", "negative"), ("[nan, 0.1, 0.1, 0.1]", "finite"),
@@ -174,7 +179,7 @@ def test_alpha_must_be_on_the_simplex_unless_normalised():
     with pytest.raises(ConfigError, match="sum to 1"):
         resolve(None, ["difficulty.alpha=[1.0, 1.0, 1.0, 1.0]"])
     cfg = resolve(None, ["difficulty.alpha=[1.0, 1.0, 1.0, 1.0]", "difficulty.normalize=true"])
-    assert cfg["difficulty"]["alpha"] == [0.25, 0.25, 0.25, 0.25]
+    assert cfg.difficulty.alpha == (0.25, 0.25, 0.25, 0.25)
     with pytest.raises(ConfigError, match="thresholds"):
         resolve(None, ["difficulty.thresholds=[0.6, 0.3]"])
 
@@ -208,3 +213,80 @@ def test_help_lists_every_option():
     assert out.returncode == 0
     for opt in ("--study", "--config", "--set", "--out", "--quick", "--resume", "--force"):
         assert opt in out.stdout
+
+
+# ---------------------------------------------------------------------------
+# the configuration: typed, complete in sweeps/default.toml, checked with locations
+# ---------------------------------------------------------------------------
+
+
+def test_default_toml_is_generated_from_the_dataclasses():
+    """sweeps/default.toml lists every key with its default and description; regenerate it with
+    python -c "from ignjax.config import default_toml; print(default_toml(), end='')" > sweeps/default.toml"""
+    assert (REPO / "sweeps" / "default.toml").read_text(encoding="utf-8") == default_toml()
+    assert resolve(REPO / "sweeps" / "default.toml") == SweepConfig()
+    assert SweepConfig.from_dict(SweepConfig().to_dict()) == SweepConfig()
+
+
+@pytest.mark.parametrize("name", ["default.toml", "cost_sensitivity_large.toml"])
+def test_shipped_configs_resolve(name):
+    cfg = resolve(REPO / "sweeps" / name)
+    if name == "cost_sensitivity_large.toml":
+        assert cfg.costs.samples == 1_000_000 and cfg.run.name == "costs_large"
+
+
+def test_config_is_frozen_typed_and_checked_from_python():
+    cfg = resolve(None, ["eval.thresholds=[1, 2]", "sim.max_steps=12", "sim.collision_heights=[0.2, 1]"])
+    assert cfg.eval.thresholds == (1.0, 2.0) and isinstance(cfg.eval.thresholds[0], float)
+    assert cfg.sim == SimConfig(max_steps=12, collision_heights=(0.2, 1.0))
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        cfg.eval.batch = 3
+    with pytest.raises(ConfigError, match="eval.batch: must be >= 1"):
+        EvalConfig(batch=0)
+    with pytest.raises(ConfigError, match="expected an integer"):
+        CostsConfig(samples=1.5)
+    assert DifficultyConfig(alpha=[2, 2, 2, 2], normalize=True).alpha == (0.25, 0.25, 0.25, 0.25)
+    with pytest.raises(ConfigError, match="sim.max_steps"):
+        resolve(None, ["sim.max_steps=0"])
+    with pytest.raises(ConfigError, match="expected integers"):
+        resolve(None, ["sim.image_size=[1.5, 2]"])
+
+
+def test_errors_name_where_the_key_was_set(tmp_path):
+    p = tmp_path / "c.toml"
+    p.write_text("[run]\nname = 'x'\n\n[costs]\nseed = 1\nscales = [1.0, -2.0]\n")
+    with pytest.raises(ConfigError, match=r"c.toml:6: costs.scales: scales must be positive"):
+        resolve(p)
+    p.write_text("[eval]\nbatch = 'many'\n")
+    with pytest.raises(ConfigError, match=r"c.toml:2: eval.batch: expected an integer"):
+        resolve(p)
+    p.write_text("[eval]\nbatch = 0\n")
+    assert resolve(p, ["eval.batch=8"]).eval.batch == 8  # a later layer may repair an earlier one's value
+    with pytest.raises(ConfigError, match=r"c.toml:2: eval.batch: must be >= 1"):
+        resolve(p)
+    with pytest.raises(ConfigError, match=r"--set: eval.agents: unknown agent 'oracle'"):
+        resolve(p, ["eval.batch=8", "eval.agents=['oracle']"])
+    with pytest.raises(ConfigError, match=r"--set: difficulty.alpha: .*sum to 1"):
+        resolve(None, ["difficulty.alpha=[1.0, 1.0, 1.0, 1.0]"])
+
+
+def test_fingerprint_is_a_function_of_the_configuration():
+    a, b = resolve(None, ["costs.samples=7"]), resolve(None, ["costs.samples=7"])
+    assert fingerprint(a, ["eval"]) == fingerprint(b, ["eval"])
+    assert fingerprint(a, ["eval"]) != fingerprint(a, ["eval", "costs"])
+    assert fingerprint(a, ["eval"]) != fingerprint(resolve(None, ["costs.samples=8"]), ["eval"])
+    assert fingerprint(a, ["eval"]) != fingerprint(resolve(None, ["costs.samples=7", "sim.max_steps=21",
+                                                                  "sim.trace_len=21"]), ["eval"])
+
+
+def test_checkpoint_stage_is_absent_until_complete(tmp_path):
+    ck = Checkpoints(tmp_path / "checkpoints")
+    stale = tmp_path / "checkpoints" / "eval__x.orbax-checkpoint-tmp"  # what a save killed midway leaves
+    stale.mkdir(parents=True)
+    (stale / "junk").write_text("partial")
+    assert not ck.has("eval/x")
+    tree = {"out": {"a": np.arange(5, dtype=np.float32)}, "costs": np.eye(2)}
+    ck.save("eval/x", tree)
+    assert ck.has("eval/x") and not stale.exists()
+    got = ck.load("eval/x")
+    assert np.array_equal(got["out"]["a"], tree["out"]["a"]) and np.array_equal(got["costs"], tree["costs"])

@@ -1,0 +1,72 @@
+"""The run folder of a sweep: which run it holds (``run.json``) and the
+rollout stages already finished (``checkpoints/``, orbax), so that
+``--resume`` continues exactly where a killed run stopped."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import orbax.checkpoint as ocp
+
+from ignjax.config import SweepConfig, fingerprint
+from ignjax.errors import InputError
+from ignjax.fileio import atomic_write
+
+
+def prepare_folder(out: Path, cfg: SweepConfig, studies: list[str], resume: bool, force: bool) -> None:
+    """Create or reuse the run folder; refuse one that holds another run."""
+    meta = out / "run.json"
+    fp = fingerprint(cfg, studies)
+    if out.exists() and any(out.iterdir()):
+        if force:
+            shutil.rmtree(out)
+        elif not meta.is_file():
+            raise InputError(str(out), "--out", "folder is not empty and holds no ignjax run; use --force to replace it")
+        else:
+            old = json.loads(meta.read_text())
+            if old.get("fingerprint") != fp:
+                raise InputError(str(meta), "fingerprint",
+                                 "the folder holds a different run (other configuration or studies); "
+                                 "use another --out, or --force to replace it")
+            if not resume:
+                raise InputError(str(out), "--out", "the folder already holds this run; use --resume to continue "
+                                                    "it or --force to start over")
+    out.mkdir(parents=True, exist_ok=True)
+    if not meta.is_file():
+        atomic_write(meta, json.dumps({"fingerprint": fp, "studies": studies, "config": cfg.to_dict()}, indent=2,
+                                      sort_keys=True) + "\n")
+
+
+class Checkpoints:
+    """Finished rollout stages of a run, saved with orbax (one folder per stage).
+
+    A stage is either absent or complete: orbax writes a save into
+    ``<stage>.orbax-checkpoint-tmp`` and renames it to ``<stage>`` only once
+    every file is written (its atomic-rename commit on local file systems),
+    and a later save of the same stage first deletes such an unfinished
+    folder. So a run killed mid-save (even by SIGKILL) has no ``<stage>``
+    folder, and ``--resume`` recomputes that stage from the same inputs.
+    """
+
+    def __init__(self, root: Path):
+        self.root = root
+
+    def _path(self, name: str) -> Path:
+        return self.root / name.replace("/", "__")
+
+    def has(self, name: str) -> bool:
+        return self._path(name).is_dir()
+
+    def load(self, name: str) -> dict:
+        with ocp.PyTreeCheckpointer() as ck:
+            return ck.restore(self._path(name).resolve())
+
+    def save(self, name: str, tree: dict) -> None:
+        self.root.mkdir(parents=True, exist_ok=True)
+        with ocp.PyTreeCheckpointer() as ck:
+            ck.save(self._path(name).resolve(), tree)
+
+
+__all__ = ["Checkpoints", "prepare_folder"]
