@@ -17,61 +17,38 @@ name               asks   privileged  behaviour
                                       ratio exceeds a threshold (Eq. 1, computed exactly)
 =================  =====  ==========  ======================================================
 
-The EIG agent's belief
-    Hypotheses are the candidate slots of :class:`~ignjax.agents.base.Memory`
-    (instances of the instruction's category seen so far, minus those a
-    Type-4 answer rejected) plus one "not seen yet" hypothesis whose prior
-    weight is ``max(prior_count - seen, 0.25)``. Each hypothesis carries the
-    log-likelihood of the answers received so far.
-
-    Answer models (likelihood of answer a under hypothesis h):
-
-    * Type 1: a = the target's colour. A seen candidate answers its observed
-      colour (uniform when unobserved); "not seen" answers uniformly over
-      the 12 colours. Once the answer is known the question is worth 0.
-    * Type 2: a = the goal room label (12 labels). A candidate answers the
-      room label the agent stood in when it saw it (uniform when unknown);
-      "not seen" answers uniformly. Worth 0 once known.
-    * Type 3: a = the sector (8) of the route's way out. A candidate answers
-      the sector of its bearing with probability 0.6 and each neighbouring
-      sector with 0.2 (routes bend); "not seen" answers uniformly.
-    * Type 4: about the most probable candidate in the front view within
-      3 m: yes under that candidate, no under every other hypothesis. Worth
-      0 when no candidate is in front.
-
-    EIG_t = H[b] - sum_a p(a) H[b | a] (nats) for each type, exactly on the
-    belief; the agent asks the type maximising EIG_t / w_t if that ratio
-    exceeds ``threshold`` and questions are left. Otherwise it moves: to
-    the most probable candidate when its posterior exceeds ``commit``
-    (stopping there when closer than ``stop_range`` with posterior at least
-    ``p_stop``), else it explores, biased toward the last route hint.
-    In the last ``DEADLINE_STEPS`` planner steps every belief agent heads
-    for its most probable seen candidate and stops there, and its final
-    step is always a STOP (ending without one is a certain failure).
-    Because the costs w enter only through EIG / w, raising a cost lowers
-    the asking rate of that type.
+The belief-based agents (explorer, naive asker, EIG agent) keep a
+:class:`~ignjax.agents.memory.Memory` and the belief of
+:mod:`ignjax.agents.belief` (hypotheses, answer models, EIG per question
+type). The EIG agent asks the type maximising EIG_t / w_t if that ratio
+exceeds ``threshold`` and questions are left. Otherwise a belief agent
+moves: to the most probable candidate when its posterior exceeds ``commit``
+(stopping there when closer than ``stop_range`` with posterior at least
+``p_stop``), else it explores, biased toward the belief's unseen mass
+(where route hints point; the explorer is not biased). In the last
+``DEADLINE_STEPS`` planner steps every belief agent heads for its most
+probable seen candidate and stops there, and its final step is always a
+STOP (ending without one is a certain failure). Because the costs w enter
+only through EIG / w, raising a cost lowers the asking rate of that type.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import math
-from dataclasses import dataclass
-from types import MappingProxyType
 
 import jax
 import jax.numpy as jnp
 
-from ignjax.agents.base import (
-    Agent, Memory, candidate_relative, explore_direction, move_toward, observe_memory, pytree_dataclass,
+from ignjax.agents.agent import Agent
+from ignjax.agents.belief import (
+    BeliefParams, default_belief_params, question_eigs, unseen_direction, update_belief,
 )
-from ignjax.evaluate.metrics import LOCKED_COSTS
-from ignjax.scenes import vocab
+from ignjax.agents.memory import N_ROOM_LABELS, Memory, candidate_relative, observe_memory
+from ignjax.agents.motion import explore_direction, move_toward
+from ignjax.arrays import pytree_dataclass
 from ignjax.sim import types as T
 
 DEADLINE_STEPS = 4  # belief agents commit to their best seen candidate this many steps before the end
-N_COLORS = len(vocab.COLORS)
-N_ROOM_LABELS = len(vocab.ALL_ROOM_LABELS)
 
 
 # ---------------------------------------------------------------------------
@@ -80,7 +57,6 @@ N_ROOM_LABELS = len(vocab.ALL_ROOM_LABELS)
 
 
 @pytree_dataclass
-@dataclass(frozen=True)
 class RandomParams:
     """stop_prob: () probability of STOP at each decision."""
 
@@ -109,7 +85,6 @@ RANDOM = Agent("random", _random_init, _random_act, lambda: RandomParams(jnp.flo
 
 
 @pytree_dataclass
-@dataclass(frozen=True)
 class PathParams:
     """stop_distance: () stop when the geodesic distance is below this, m."""
 
@@ -127,167 +102,8 @@ SHORTEST_PATH = Agent("shortest_path", _random_init, _path_act, lambda: PathPara
 
 
 # ---------------------------------------------------------------------------
-# belief machinery shared by explorer, naive asker and EIG agent
+# the step shared by the belief-based agents: explorer, naive asker and EIG agent
 # ---------------------------------------------------------------------------
-
-
-@pytree_dataclass
-@dataclass(frozen=True)
-class BeliefParams:
-    """Parameters of the belief-based agents.
-
-    Attributes:
-        costs: (4,) per-type question costs the agent is charged (EIG agent).
-        threshold: () ask when max_t EIG_t / w_t exceeds this (EIG agent).
-        commit: () posterior above which the agent walks to a candidate.
-        p_stop: () posterior needed to stop at a candidate without asking.
-        stop_range: () distance to a candidate at which the agent stops, m.
-        prior_count: () prior expected number of instances of the category.
-    """
-
-    costs: jax.Array
-    threshold: jax.Array
-    commit: jax.Array
-    p_stop: jax.Array
-    stop_range: jax.Array
-    prior_count: jax.Array
-
-
-def default_belief_params(**kw) -> BeliefParams:
-    base = dict(costs=jnp.asarray(LOCKED_COSTS, jnp.float32), threshold=jnp.float32(2.5), commit=jnp.float32(0.5),
-                p_stop=jnp.float32(0.8), stop_range=jnp.float32(1.0), prior_count=jnp.float32(3.0))
-    base.update({k: jnp.asarray(v, jnp.float32) for k, v in kw.items()})
-    return BeliefParams(**base)
-
-
-def _abs_sector(obs: T.Observation):
-    """(8,) relative sector (0..7) of each absolute world sector from the agent's heading."""
-    head = (jnp.round(obs.heading / (math.pi / 4)).astype(jnp.int32)) % 8
-    return (jnp.arange(8) - head) % 8
-
-
-def _sector_likelihood(answer, sectors):
-    """P(route answer sector | hypothesis sector): 0.6 same, 0.2 each neighbour."""
-    diff = jnp.minimum((sectors - answer) % 8, (answer - sectors) % 8)
-    return jnp.where(diff == 0, 0.6, jnp.where(diff == 1, 0.2, 1e-3))
-
-
-def _fold_answers(mem: Memory, obs: T.Observation, answers: T.Answer) -> Memory:
-    """Fold the answer to last step's question (if any) into the belief."""
-    q = mem.last_asked
-    fresh = (q > 0) & ~answers.refused & (answers.last_type == q)
-    M = mem.handle.shape[0]
-    labels = jnp.arange(N_ROOM_LABELS)[:, None]
-    rel = _abs_sector(obs)[None, :]
-    # Type 1: colour
-    colour_bad = (mem.attrs[:, 0] >= 0) & (mem.attrs[:, 0] != answers.color) & (answers.color >= 0)
-    d1 = jnp.where(colour_bad, -8.0, 0.0)
-    u1 = jnp.full((N_ROOM_LABELS, 8), jnp.where(answers.color >= 0, -math.log(N_COLORS), 0.0))
-    # Type 2: room label
-    room_bad = (mem.room >= 0) & (mem.room != answers.room_label) & (answers.room_label >= 0)
-    d2 = jnp.where(room_bad, -4.0, 0.0)
-    u2 = jnp.where((answers.room_label >= 0) & (labels != answers.room_label), -30.0, 0.0) * jnp.ones((1, 8))
-    # Type 3: route sector (relative at asking time = now)
-    _, bearing = candidate_relative(mem, obs)
-    cs = (jnp.round(bearing / (math.pi / 4)).astype(jnp.int32)) % 8
-    d3 = jnp.log(_sector_likelihood(answers.hint_sector, cs))
-    u3 = jnp.log(_sector_likelihood(answers.hint_sector, rel)) * jnp.ones((N_ROOM_LABELS, 1))
-    # Type 4
-    yes = answers.confirm == 1
-    slot = mem.asked_about
-    onehot = jnp.arange(M) == slot
-    d4 = jnp.where(yes, jnp.where(onehot, 0.0, -jnp.inf), 0.0)
-    rej4 = jnp.where(~yes & (slot >= 0), onehot, False)
-    u4 = jnp.where(yes, -jnp.inf, 0.0) * jnp.ones((N_ROOM_LABELS, 8))
-    d = jnp.select([q == 1, q == 2, q == 3, q == 4], [d1, d2, d3, d4], jnp.zeros(M))
-    u = jnp.select([q == 1, q == 2, q == 3, q == 4], [u1, u2, u3, u4], jnp.zeros((N_ROOM_LABELS, 8)))
-    new_hint = fresh & (q == 3)
-    return dataclasses.replace(
-        mem,
-        logw=jnp.where(fresh, mem.logw + d, mem.logw),
-        unseen_logw=jnp.where(fresh, mem.unseen_logw + u, mem.unseen_logw),
-        rejected=mem.rejected | (fresh & (q == 4) & rej4),
-        hint_heading=jnp.where(new_hint, obs.heading + answers.hint_sector.astype(jnp.float32) * (math.pi / 4), mem.hint_heading),
-        has_hint=mem.has_hint | new_hint,
-        pending_stop=mem.pending_stop | (fresh & (q == 4) & yes & (answers.follow_up == T.FOLLOW_ONE_MOVE)),
-    )
-
-
-def belief(mem: Memory, params: BeliefParams):
-    """Posterior over hypotheses: (M,) candidate slots followed by
-    (L * 8,) "not seen yet, room label l, absolute sector s" (row-major)."""
-    valid = (mem.handle >= 0) & ~mem.rejected
-    n_seen = jnp.sum(valid)
-    lw = jnp.where(valid, mem.logw, -jnp.inf)
-    n_unseen = N_ROOM_LABELS * 8
-    lu = jnp.log(jnp.maximum(params.prior_count - n_seen, 0.25)) - math.log(n_unseen) + mem.unseen_logw.reshape(-1)
-    logits = jnp.concatenate([lw, lu])
-    logits = jnp.where(jnp.all(jnp.isneginf(logits)), jnp.zeros_like(logits), logits)
-    return jax.nn.softmax(logits)
-
-
-def _entropy(p, axis=-1):
-    return -jnp.sum(jnp.where(p > 0, p * jnp.log(jnp.where(p > 0, p, 1.0)), 0.0), axis=axis)
-
-
-def expected_information_gain(b, L):
-    """Eq. (1): H[b] - E_{a ~ p(a)} H[b | a] for a likelihood matrix L (A, Hyp),
-    the general form (:func:`question_eigs` computes the same quantity from
-    the structure of each answer model; tests check one against the other)."""
-    pa = L @ b  # Shape: (A,)
-    post = L * b[None] / jnp.where(pa > 0, pa, 1.0)[:, None]
-    return _entropy(b) - jnp.sum(pa * _entropy(post, axis=1))
-
-
-def question_eigs(mem: Memory, obs: T.Observation, answers: T.Answer, b):
-    """(4,) EIG of each question type on belief ``b``; also the Type-4 slot.
-
-    Eq. (1) through the mutual-information identity
-    H[b] - E_a H[b | a] = H[p(a)] - sum_h b_h H[p(a | h)], on the structure
-    of each type's answer model: only the (A,) answer distribution p(a) and
-    the answer entropy of each hypothesis are needed."""
-    M = mem.handle.shape[0]
-    valid = (mem.handle >= 0) & ~mem.rejected
-    bc, bu = b[:M], b[M:].reshape(N_ROOM_LABELS, 8)  # Shape: (M,), (L, 8)
-    # Type 1: colour; candidates of unobserved colour and unseen hypotheses answer uniformly
-    col = mem.attrs[:, 0]
-    uniform1 = jnp.sum(jnp.where(col < 0, bc, 0.0)) + jnp.sum(bu)
-    pa1 = jnp.sum(jnp.where(jnp.arange(N_COLORS)[:, None] == col[None], bc[None], 0.0), axis=1) + uniform1 / N_COLORS
-    e1 = _entropy(pa1) - uniform1 * math.log(N_COLORS)
-    # Type 2: room label; an unseen hypothesis answers its own label
-    uniform2 = jnp.sum(jnp.where(mem.room < 0, bc, 0.0))
-    pa2 = jnp.sum(jnp.where(jnp.arange(N_ROOM_LABELS)[:, None] == mem.room[None], bc[None], 0.0), axis=1) \
-        + jnp.sum(bu, axis=1) + uniform2 / N_ROOM_LABELS
-    e2 = _entropy(pa2) - uniform2 * math.log(N_ROOM_LABELS)
-    # Type 3: sector; every hypothesis answers a rotation of the same distribution
-    dist, bearing = candidate_relative(mem, obs)
-    cs = (jnp.round(bearing / (math.pi / 4)).astype(jnp.int32)) % 8
-    sectors = jnp.arange(8)[:, None]
-    mass = jnp.sum(jnp.where(sectors == cs[None], bc[None], 0.0), axis=1) \
-        + jnp.sum(jnp.where(sectors == _abs_sector(obs)[None], jnp.sum(bu, axis=0)[None], 0.0), axis=1)  # Shape: (8,)
-    L3 = _sector_likelihood(sectors, jnp.arange(8)[None])
-    L3 = L3 / L3.sum(0, keepdims=True)  # Shape: (A, 8) answer given the hypothesis' sector
-    e3 = _entropy(L3 @ mass) - jnp.sum(mass) * _entropy(L3[:, 0])
-    # Type 4: the most probable candidate in front within 3 m; the answer is certain under every hypothesis
-    in_front = valid & (dist <= 3.0) & (jnp.abs(bearing) <= math.pi / 4) \
-        & jnp.any(mem.handle[:, None] == obs.visible_handle[None, :], axis=1)
-    slot = jnp.argmax(jnp.where(in_front, bc, -1.0))
-    has = jnp.any(in_front)
-    e4 = _entropy(jnp.stack([bc[slot], jnp.sum(b) - bc[slot]]))
-    e = jnp.stack([e1, e2, e3, e4])
-    e = e * jnp.stack([~answers.known[0], ~answers.known[1], jnp.array(True), has])
-    return jnp.maximum(e, 0.0), jnp.where(has, slot, -1)
-
-
-def unseen_direction(mem: Memory, b):
-    """(heading, concentration): circular mean of the unseen mass over
-    absolute sectors, and its resultant length in [0, 1]."""
-    M = mem.handle.shape[0]
-    mass = b[M:].reshape(N_ROOM_LABELS, 8).sum(0)
-    ang = jnp.arange(8) * (math.pi / 4)
-    x, y = jnp.sum(mass * jnp.cos(ang)), jnp.sum(mass * jnp.sin(ang))
-    total = jnp.maximum(jnp.sum(mass), 1e-9)
-    return jnp.arctan2(y, x), jnp.hypot(x, y) / total
 
 
 def _move_policy(mem: Memory, obs: T.Observation, params: BeliefParams, b, key, hint_weight):
@@ -326,13 +142,6 @@ def _finish(mem: Memory, obs, answers, act: T.Action, asked_about):
     )
 
 
-def _prepare(params, obs, answers, mem):
-    mem = _fold_answers(mem, obs, answers)
-    mem = observe_memory(mem, obs, jnp.where(answers.known[0], answers.color, -1),
-                         jnp.where(answers.known[1], answers.room_label, -1))
-    return mem, belief(mem, params)
-
-
 def _with_stop_now(answers, mem, act):
     stop_now = (mem.last_asked == 4) & (answers.confirm == 1) & (answers.follow_up == T.FOLLOW_STOP_NOW)
     return jax.tree.map(lambda s, a: jnp.where(stop_now, s, a), T.Action.make(T.STOP), act)
@@ -341,7 +150,7 @@ def _with_stop_now(answers, mem, act):
 # explorer -------------------------------------------------------------------
 
 def _explorer_act(params, obs, answers, mem, key, priv):
-    mem, _ = _prepare(params, obs, answers, mem)
+    mem, _ = update_belief(params, obs, answers, mem)
     # no answers: every seen candidate is as likely as the others; commit to the nearest
     valid = (mem.handle >= 0) & ~mem.rejected
     dist, _ = candidate_relative(mem, obs)
@@ -360,7 +169,7 @@ EXPLORER = Agent("explorer", _belief_init, _explorer_act, default_belief_params,
 # naive asker ------------------------------------------------------------------
 
 def _naive_act(params, obs, answers, mem, key, priv):
-    mem, b = _prepare(params, obs, answers, mem)
+    mem, b = update_belief(params, obs, answers, mem)
     eigs, slot4 = question_eigs(mem, obs, answers, b)
     has_q = obs.questions_left > 0
     M = mem.handle.shape[0]
@@ -383,7 +192,7 @@ NAIVE_ASKER = Agent("naive_asker", _belief_init, _naive_act, default_belief_para
 # EIG agent ------------------------------------------------------------------------
 
 def _eig_act(params, obs, answers, mem, key, priv):
-    mem, b = _prepare(params, obs, answers, mem)
+    mem, b = update_belief(params, obs, answers, mem)
     eigs, slot4 = question_eigs(mem, obs, answers, b)
     ratio = eigs / jnp.maximum(params.costs, 1e-6)
     q = jnp.argmax(ratio) + 1
@@ -399,5 +208,4 @@ EIG = Agent("eig", _belief_init, _eig_act, default_belief_params, asks=True,
             description="cost-aware: asks argmax_t EIG_t / w_t when it exceeds a threshold (Eq. 1 on its belief)")
 
 
-AGENTS = MappingProxyType({a.name: a for a in (RANDOM, SHORTEST_PATH, EXPLORER, NAIVE_ASKER, EIG)})
-"""Built-in agents by name (immutable)."""
+__all__ = ["DEADLINE_STEPS", "EIG", "EXPLORER", "NAIVE_ASKER", "PathParams", "RANDOM", "RandomParams", "SHORTEST_PATH"]

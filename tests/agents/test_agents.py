@@ -10,6 +10,7 @@ shape per agent) with the per-episode keys of :func:`ignjax.sim.rollout.episode_
 from __future__ import annotations
 
 import dataclasses
+import math
 from functools import partial
 
 import chex
@@ -18,11 +19,19 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+from ignjax.agents import Agent, get_agent, registry
+from ignjax.agents import belief as B
+from ignjax.agents.memory import N_ROOM_LABELS, Memory, candidate_relative, observe_memory, visit_index
 from ignjax.evaluate import metrics as M
-from ignjax.agents.base import Agent, get_agent, registry
 from ignjax.evaluate.runner import run_agent
-from ignjax.sim.rollout import Privileged, episode_keys, pad_specs, rollout, rollout_episode, rollout_sweep
+from ignjax.protocol import CONFIRM_RANGE, LOCKED_COSTS
+from ignjax.sim import env as E
 from ignjax.sim import types as T
+from ignjax.sim.rollout import (
+    _EXECUTABLES, MIN_PART_ROWS, PARTS, ROLLOUT_COMPILER_OPTIONS, _in_parts, batch_parts, episode_keys,
+    pad_specs, rollout, rollout_episode, rollout_rows, rollout_sweep,
+)
+from ignjax.sim.types import Privileged
 
 SEED = 0
 SCALES = (0.25, 1.0, 4.0)  # the EIG agent's charged costs: locked costs x these
@@ -58,7 +67,7 @@ def runs(small_benchmark, small_world):
     base = eig.default_params()
     K = len(SCALES)
     params = jax.tree.map(lambda x: jnp.broadcast_to(x, (K,) + jnp.shape(x)), base)
-    costs = jnp.asarray(M.LOCKED_COSTS, jnp.float32)[None] * jnp.asarray(SCALES, jnp.float32)[:, None]
+    costs = jnp.asarray(LOCKED_COSTS, jnp.float32)[None] * jnp.asarray(SCALES, jnp.float32)[:, None]
     params = dataclasses.replace(params, costs=costs)
     res["eig_sweep"] = jax.tree.map(np.asarray, rollout_sweep(small_world, specs, eig, params, keys))
     res["eig_params"] = params
@@ -135,13 +144,8 @@ def test_only_the_privileged_agent_receives_privileged_information(small_benchma
 
 def _reference_likelihoods(mem, obs):
     """The EIG agent's answer models as explicit (A, hypotheses) likelihood
-    matrices (see :mod:`ignjax.agents.policies`), for one episode."""
-    import math
-
-    from ignjax.agents import policies as P
-    from ignjax.agents.base import candidate_relative
-
-    L_, C_ = P.N_ROOM_LABELS, P.N_COLORS
+    matrices (see :mod:`ignjax.agents.belief`), for one episode."""
+    L_, C_ = N_ROOM_LABELS, B.N_COLORS
     U = L_ * 8
     valid = (mem.handle >= 0) & ~mem.rejected
     col = mem.attrs[:, 0]
@@ -152,11 +156,12 @@ def _reference_likelihoods(mem, obs):
                           (jnp.arange(L_)[:, None] == jnp.repeat(jnp.arange(L_), 8)[None]).astype(jnp.float32)], axis=1)
     dist, bearing = candidate_relative(mem, obs)
     cs = (jnp.round(bearing / (math.pi / 4)).astype(jnp.int32)) % 8
-    u_rel = jnp.tile(P._abs_sector(obs), L_)
+    u_rel = jnp.tile(B._abs_sector(obs), L_)
     a = jnp.arange(8)[:, None]
-    L3 = jnp.concatenate([P._sector_likelihood(a, cs[None]), P._sector_likelihood(a, u_rel[None])], axis=1)
+    L3 = jnp.concatenate([B._sector_likelihood(a, cs[None]), B._sector_likelihood(a, u_rel[None])], axis=1)
     L3 = L3 / L3.sum(0, keepdims=True)
-    in_front = valid & (dist <= 3.0) & (jnp.abs(bearing) <= math.pi / 4) & jnp.isin(mem.handle, obs.visible_handle)
+    in_front = valid & (dist <= CONFIRM_RANGE) & (jnp.abs(bearing) <= math.pi / 4) \
+        & jnp.isin(mem.handle, obs.visible_handle)
     return (L1, L2, L3), in_front
 
 
@@ -164,9 +169,6 @@ def test_question_eigs_equal_eq1_on_explicit_answer_models(small_benchmark, smal
     """The agent's structured EIG per question type equals Eq. (1),
     H[b] - E_a H[b | a], evaluated directly on the explicit likelihood
     matrices of its answer models, along real rollouts."""
-    from ignjax.agents import policies as P
-    from ignjax.sim import env as E
-
     es = small_benchmark["set"]
     specs, keys = _batch(es)
     agent = get_agent("eig")
@@ -179,13 +181,13 @@ def test_question_eigs_equal_eq1_on_explicit_answer_models(small_benchmark, smal
     observe = jax.jit(jax.vmap(lambda st: E.observe(small_world, st)))
 
     def check(o, ans, mem):
-        mem, b = P._prepare(params, o, ans, mem)
-        got, slot = P.question_eigs(mem, o, ans, b)
+        mem, b = B.update_belief(params, o, ans, mem)
+        got, slot = B.question_eigs(mem, o, ans, b)
         (L1, L2, L3), in_front = _reference_likelihoods(mem, o)
         M_ = mem.handle.shape[0]
         yes = jnp.concatenate([(jnp.arange(M_) == slot).astype(jnp.float32), jnp.zeros(b.shape[0] - M_)])
         L4 = jnp.stack([yes, 1.0 - yes])
-        ref = jnp.stack([P.expected_information_gain(b, L) for L in (L1, L2, L3, L4)])
+        ref = jnp.stack([B.expected_information_gain(b, L) for L in (L1, L2, L3, L4)])
         ref = ref * jnp.stack([~ans.known[0], ~ans.known[1], jnp.array(True), jnp.any(in_front)])
         return got, jnp.maximum(ref, 0.0), slot, jnp.where(jnp.any(in_front), jnp.argmax(jnp.where(in_front, b[:M_], -1.0)), -1)
 
@@ -227,8 +229,6 @@ def test_batched_rollout_equals_one_episode_rollout(small_benchmark, small_world
     reached, heading free, EIG / cost above the threshold) can turn that into
     another decision in a rare episode, so up to 1 in 20 episodes may differ;
     a change of behaviour would show in most of them."""
-    from ignjax.sim.rollout import ROLLOUT_COMPILER_OPTIONS
-
     es = small_benchmark["set"]
     specs, keys = _batch(es)
     agent = get_agent(name)
@@ -247,8 +247,6 @@ def test_sweep_simulates_each_distinct_trajectory_once_with_the_same_result(smal
     """rollout_sweep simulates the settings of an episode that act alike once
     (group mode); the result equals every row simulated on its own, exactly
     (same chunk width in both, so the same vectorised code runs per row)."""
-    from ignjax.sim.rollout import ROLLOUT_COMPILER_OPTIONS, rollout_rows
-
     es = small_benchmark["set"]
     specs, keys = _batch(es)
     eig, params = get_agent("eig"), runs["eig_params"]
@@ -271,12 +269,9 @@ def test_sweep_simulates_each_distinct_trajectory_once_with_the_same_result(smal
 
 
 def test_visit_counts_saturate_instead_of_wrapping(small_benchmark, small_world):
-    from ignjax.agents.base import Memory, _visit_index, observe_memory
-    from ignjax.sim import env as E
-
     spec = jax.tree.map(lambda a: a[0], small_benchmark["set"].specs)
     obs = E.observe(small_world, E.reset(small_world, spec))
-    ij = np.asarray(_visit_index(obs.odometry[:2]))
+    ij = np.asarray(visit_index(obs.odometry[:2]))
     mem = Memory.empty()
     once = observe_memory(mem, obs)
     assert int(once.visits[ij[1], ij[0]]) == 1 and int(once.visits.sum()) == 1
@@ -287,8 +282,6 @@ def test_visit_counts_saturate_instead_of_wrapping(small_benchmark, small_world)
 
 
 def test_batch_parts_depend_on_the_batch_and_backend_only():
-    from ignjax.sim.rollout import MIN_PART_ROWS, PARTS, batch_parts
-
     cpu = jax.default_backend() == "cpu"
     assert batch_parts(PARTS * MIN_PART_ROWS) == (PARTS if cpu else 1)
     assert batch_parts(PARTS * MIN_PART_ROWS - 1) == 1
@@ -298,8 +291,6 @@ def test_batch_parts_depend_on_the_batch_and_backend_only():
 def test_pieces_are_split_padded_and_joined_in_order(small_benchmark, small_world):
     """A batch run in pieces (the last padded with finished copies) gives
     each row what one call on the whole batch gives it, on both output layouts."""
-    from ignjax.sim.rollout import _EXECUTABLES, _in_parts
-
     @partial(jax.jit, static_argnames=("agent", "chunk"))
     def rows(world, specs, agent, params, keys, chunk=None):
         v = specs.field * 1000 + specs.target * 10 + specs.valid + jax.random.randint(keys[0], (), 0, 3) * 0
