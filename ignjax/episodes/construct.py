@@ -6,7 +6,7 @@ Per scene (:func:`scene_episodes`):
    reached are reported and their targets skipped);
 2. inventory and candidate targets (:mod:`ignjax.episodes.inventory`);
 3. one geodesic distance field per candidate (all candidates of a scene in
-   one vmapped call of :func:`ignjax.scenes.navgrid.geodesic_field`);
+   one vmapped call, :func:`ignjax.scenes.geodesic.goal_fields`);
 4. a description that separates the target from its distractors
    (:mod:`ignjax.episodes.describe`), else the candidate is dropped;
 5. a **reference view**: an eye pose 1-3 m from the target, in its room,
@@ -41,8 +41,6 @@ import warnings
 import zlib
 from dataclasses import dataclass, field
 
-import jax
-import jax.numpy as jnp
 import mujoco
 import numpy as np
 
@@ -55,8 +53,9 @@ from ignjax.episodes.inventory import InventoryConfig, build_inventory
 from ignjax.episodes.schema import SCHEMA, CONSTRUCTION_SCHEMA, VERSION
 from ignjax.errors import ConfigError, SceneError
 from ignjax.scenes.compile import CompiledScene, compile_scene
+from ignjax.scenes.geodesic import goal_fields
 from ignjax.scenes.model import Scene
-from ignjax.scenes.navgrid import GridConfig, NavGrid, build_navgrid, geodesic_field, seeds_from_box, unreachable_rooms
+from ignjax.scenes.navgrid import GridConfig, NavGrid, build_navgrid, unreachable_rooms
 
 
 @dataclass(frozen=True)
@@ -127,42 +126,6 @@ class SceneReport:
 
 def _rng(seed: int, *keys: str) -> np.random.Generator:
     return np.random.default_rng(np.random.SeedSequence([seed] + [zlib.crc32(k.encode()) for k in keys]))
-
-
-def _pad_to(n: int, m: int = 32) -> int:
-    return int(math.ceil(n / m) * m)
-
-
-_FIELDS_FN = None
-
-
-def goal_fields(grid: NavGrid, boxes: list, room_indices: list[int], seed_radius: float) -> np.ndarray:
-    """Geodesic fields (K, H, W) float32 to K objects on one grid (vmapped).
-
-    The grid is padded to multiples of 32 cells (not navigable) so scenes of
-    similar size share one compiled program.
-    """
-    global _FIELDS_FN
-    if not boxes:
-        return np.zeros((0,) + tuple(grid.shape), np.float32)
-    H, W = grid.shape
-    Hp, Wp = _pad_to(H), _pad_to(W)
-    nav = np.zeros((Hp, Wp), bool)
-    nav[:H, :W] = grid.navigable
-    room = np.full((Hp, Wp), -1, np.int32)
-    room[:H, :W] = grid.room
-    if _FIELDS_FN is None:
-        def one(nav, room, origin, res, center, half, yaw, ri, radius):
-            seeds = seeds_from_box(nav, room, origin, res, center, half, yaw, ri, radius)
-            return geodesic_field(nav, seeds, res)
-
-        _FIELDS_FN = jax.jit(jax.vmap(one, in_axes=(None, None, None, None, 0, 0, 0, 0, None)), static_argnums=(3, 8))
-    centers = jnp.asarray(np.array([b.center for b in boxes], np.float32))
-    halves = jnp.asarray(np.array([b.half_extents for b in boxes], np.float32))
-    yaws = jnp.asarray(np.array([b.yaw for b in boxes], np.float32))
-    out = _FIELDS_FN(jnp.asarray(nav), jnp.asarray(room), jnp.asarray(grid.origin, jnp.float32), float(grid.resolution),
-                     centers, halves, yaws, jnp.asarray(np.array(room_indices, np.int32)), float(seed_radius))
-    return np.asarray(out)[:, :H, :W]
 
 
 def _visible(compiled: CompiledScene, eye: np.ndarray, point: np.ndarray, inst_index: int) -> bool:

@@ -10,7 +10,7 @@ grid is copied per episode.
 
 Padding never creates a path or a hit: padded grid cells are not navigable,
 have room -1 and component -1; the fast ray caster clips each ray to its own
-scene's grid extent (:class:`~ignjax.sim.rays.caster.RayGrid`); padded instances,
+scene's grid extent (:class:`~ignjax.scenes.raygrid.RayGrid`); padded instances,
 rooms and doors have ``valid = False`` and index -1 everywhere.
 
 Static metadata (not pytree leaves): scene ids, the category vocabulary, the
@@ -21,25 +21,24 @@ grids (for the exact ray path, rendering and debugging).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import partial
 from typing import Sequence
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ignjax.arrays import pytree_dataclass
 from ignjax.errors import ConfigError
 from ignjax.scenes import vocab
 from ignjax.scenes.compile import CompileOptions, CompiledScene, compile_scene
+from ignjax.scenes.geodesic import geodesic_field, seeds_from_box
 from ignjax.scenes.graph import room_adjacency
 from ignjax.scenes.model import Scene
-from ignjax.scenes.navgrid import GridConfig, NavGrid, build_navgrid, check_reachable, geodesic_field, seeds_from_box
-from ignjax.sim.rays.caster import RayGrid, ray_grid
+from ignjax.scenes.navgrid import GridConfig, NavGrid, build_navgrid, check_reachable
+from ignjax.scenes.raygrid import RayGrid, ray_grid
 
 
-@partial(jax.tree_util.register_dataclass,
-         data_fields=["navigable", "room", "components", "origin", "shape"], meta_fields=["resolution"])
-@dataclass(frozen=True)
+@pytree_dataclass(static=("resolution",))
 class GridTable:
     """2-D navigation grids of S scenes, padded to (H, W).
 
@@ -60,10 +59,7 @@ class GridTable:
     resolution: float = 0.05
 
 
-@partial(jax.tree_util.register_dataclass,
-         data_fields=["valid", "category", "center", "half_extents", "yaw", "room", "support", "structural",
-                      "color", "material", "size", "state"], meta_fields=[])
-@dataclass(frozen=True)
+@pytree_dataclass
 class InstanceTable:
     """Instances of S scenes, padded to N.
 
@@ -96,8 +92,7 @@ class InstanceTable:
     state: jax.Array
 
 
-@partial(jax.tree_util.register_dataclass, data_fields=["valid", "label", "center", "adjacency"], meta_fields=[])
-@dataclass(frozen=True)
+@pytree_dataclass
 class RoomTable:
     """Rooms of S scenes, padded to R.
 
@@ -114,8 +109,7 @@ class RoomTable:
     adjacency: jax.Array
 
 
-@partial(jax.tree_util.register_dataclass, data_fields=["valid", "position", "rooms", "width"], meta_fields=[])
-@dataclass(frozen=True)
+@pytree_dataclass
 class DoorTable:
     """Doors of S scenes, padded to D.
 
@@ -132,15 +126,13 @@ class DoorTable:
     width: jax.Array
 
 
-@partial(jax.tree_util.register_dataclass,
-         data_fields=["rays", "grid", "instances", "rooms", "doors"],
-         meta_fields=["scene_ids", "categories", "config", "compiled", "navgrids"])
+@pytree_dataclass(static=("scene_ids", "categories", "config", "compiled", "navgrids"))
 @dataclass(frozen=True, eq=False)
 class SceneBank:
     """Many scenes as one pytree (see the module docstring).
 
     Attributes:
-        rays: fast ray caster arrays (:class:`~ignjax.sim.rays.caster.RayGrid`).
+        rays: fast ray caster arrays (:class:`~ignjax.scenes.raygrid.RayGrid`).
         grid: navigation grids (:class:`GridTable`).
         instances: instance table (:class:`InstanceTable`).
         rooms: room table (:class:`RoomTable`).
@@ -353,7 +345,7 @@ def target_field(bank: SceneBank, scene_index: jax.Array, instance_index: jax.Ar
 
     Seeds are the navigable cells of the instance's room within
     ``seed_radius`` of its footprint (see
-    :func:`~ignjax.scenes.navgrid.seeds_from_box`), so the field reads as
+    :func:`~ignjax.scenes.geodesic.seeds_from_box`), so the field reads as
     "geodesic distance to the object".
 
     Args:

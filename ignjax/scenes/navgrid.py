@@ -1,11 +1,12 @@
-"""Navigation grids derived from a compiled scene, and geodesic distance fields.
+"""Navigation grids derived from a compiled scene.
 
 :func:`build_navgrid` turns a :class:`~ignjax.scenes.compile.CompiledScene`
 into a :class:`NavGrid` (host-side numpy arrays): a voxel occupancy of every
 non-floor geom, height-band occupancy, the navigable mask, a room-id grid,
 connected components, and the acceleration structures of the fast ray caster
-(:mod:`ignjax.sim.rays.caster`). :func:`geodesic_field` is the JAX array program
-for geodesic distances on the navigable mask.
+(stacked on the device by :mod:`ignjax.scenes.raygrid`, read by
+:mod:`ignjax.sim.rays.fast`). Geodesic distances on the navigable mask are
+:mod:`ignjax.scenes.geodesic`.
 
 Cells
     The grid is axis-aligned, ``resolution`` metres per cell. Rows run along
@@ -17,25 +18,6 @@ Cells
     walls snapped to the resolution lie on cell boundaries. See
     :meth:`NavGrid.world_to_cell` and :meth:`NavGrid.cell_to_world`.
 
-Voxels
-    Slice ``k`` covers heights ``[k * slice_height, (k + 1) * slice_height)``
-    from the floor (z = 0) up to ``n_slices * slice_height`` (the top of the
-    scene's geometry, rounded up to whole list bands, or
-    ``GridConfig.max_height``). Voxel ``(k, row, col)`` is occupied when some
-    geom overlaps it (closed-box overlap, shrunk by 1 um so geometry that only
-    touches a voxel face does not count). Every primitive is voxelized through
-    its oriented bounding box (a box exactly; a cylinder, sphere, ellipsoid or
-    capsule through its box, which contains it), with an exact separating-axis
-    test, so the voxelization is conservative: a 2 mm laptop screen still
-    marks every voxel it passes through. Meshes are voxelized by sampling
-    their triangles at a spacing below 0.4 voxel (conservative up to that
-    spacing); closed object meshes (geom group 2) are also filled inside.
-    The floor plane (group 0) is never voxelized, and neither are invisible
-    geoms (alpha 0, which ``mj_ray`` ignores too). The ray caster also marks
-    the slice that an upright primitive's top or bottom face only touches
-    (the face grown by 10 um, ``voxcode`` 2), so a horizontal ray at exactly
-    a table top's height still finds the table.
-
 Bands and navigability
     Band ``b`` (``GridConfig.bands``, heights in metres) is occupied in a cell
     when any slice overlapping the open interval ``(lo, hi)`` is occupied, so
@@ -45,24 +27,10 @@ Bands and navigability
     ``agent_radius`` around its centre overlaps no blocked cell (exact
     disc/square test). Components are 4-connected, which equals the
     connectivity of the 8-connected grid without corner cutting used by
-    :func:`geodesic_field`.
+    :func:`ignjax.scenes.geodesic.geodesic_field`.
 
-Acceleration structures of the fast ray caster
-    ``voxcode[k, r, c]`` (:func:`march_codes`): 0 for a voxel partly
-    occupied, 1 for one entirely inside a primitive, 2 for a free voxel that
-    a face only touches, ``c >= 3`` for a free voxel whose chessboard
-    (L-infinity, voxel index units) distance to the nearest non-free voxel
-    is ``c - 2``, so the cube of voxels within ``c - 3`` of it is free
-    (``voxcode <= 1`` is the occupancy). ``sub_box`` (:func:`pack_sub_boxes`):
-    the part of each non-free voxel, in quarters, that its geometry lies in.
-    ``prims``: every primitive geom as one or more
-    exact primitives (a box intersected with a quadric; a capsule is a
-    cylinder and two spheres); the primitives overlapping column ``(r, c)``
-    between heights ``b * list_band_height`` and ``(b + 1) *
-    list_band_height`` (a column segment) are ``seg_prims[seg_start[r, c, b]:
-    seg_start[r, c, b] + seg_count[r, c, b]]`` (compressed rows);
-    ``approx[r, c, b]``: the segment holds more than ``max_list`` primitives
-    or a mesh, so the ray caster stays at voxel accuracy there.
+Voxels, exact primitives and the ray caster's acceleration structures are
+:mod:`ignjax.scenes.voxels`.
 """
 
 from __future__ import annotations
@@ -70,29 +38,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import jax
-import jax.numpy as jnp
 import mujoco
 import numpy as np
 from scipy import ndimage
 
 from ignjax.errors import ConfigError, SceneError
-from ignjax.scenes.model import OrientedBox, Scene, points_in_polygon
-
-#: Columns of a row of :attr:`NavGrid.prims`.
-PRIM_COLUMNS = ("cx", "cy", "cz", "r00", "r01", "r02", "r10", "r11", "r12", "r20", "r21", "r22",
-                "hx", "hy", "hz", "qa", "qb", "qc")
-"""A primitive is ``{p : |p_local| <= h} & {qa x^2 + qb y^2 + qc z^2 <= 1}`` in
-its local frame ``p_local = R^T (p - c)``; ``R`` is stored row-major. A box has
-``q = 0``; a cylinder (radius r, half height h) ``h = (r, r, h), q = (1/r^2,
-1/r^2, 0)``; an ellipsoid with semi-axes a, b, c ``h = (a, b, c), q = (1/a^2,
-1/b^2, 1/c^2)``. An unused row has ``h = -1`` (never hit)."""
-
-N_PRIM_COLUMNS = len(PRIM_COLUMNS)
-_SHRINK = 1e-6  # metres: geometry that only touches a voxel face does not occupy it
-_TOUCH = 1e-5  # metres: ...but the ray caster still looks there (rays grazing a face hit it, as in mj_ray)
-VOX_PARTIAL, VOX_FULL, VOX_TOUCH = 0, 1, 2
-FREE_MAX = 252  # largest chessboard distance stored (code 254; 255 is padding)
+from ignjax.scenes.model import Scene, points_in_polygon
+from ignjax.scenes.voxels import march_codes, scene_extent, voxelize
 
 
 # ---------------------------------------------------------------------------
@@ -227,10 +179,10 @@ class NavGrid:
         navigable: (H, W) bool.
         components: (H, W) int32 component label of navigable cells, -1 elsewhere.
         n_components: number of components.
-        voxcode: (Z, H, W) uint8 march code of each voxel (see :func:`march_codes`).
+        voxcode: (Z, H, W) uint8 march code of each voxel (see :func:`~ignjax.scenes.voxels.march_codes`).
         sub_box: (Z, H, W) uint16 where in each occupied voxel its geometry
-            lies (see :func:`pack_sub_boxes`); 0 in free voxels.
-        prims: (P, 18) float32 exact primitives, see :data:`PRIM_COLUMNS`.
+            lies (see :func:`~ignjax.scenes.voxels.pack_sub_boxes`); 0 in free voxels.
+        prims: (P, 18) float32 exact primitives, see :data:`~ignjax.scenes.voxels.PRIM_COLUMNS`.
         prim_geom: (P,) int32 MuJoCo geom id of each primitive.
         seg_start: (H, W, B) int32 first entry of each column segment in ``seg_prims``.
         seg_count: (H, W, B) uint8 number of primitives of each segment.
@@ -312,375 +264,8 @@ class NavGrid:
 
 
 # ---------------------------------------------------------------------------
-# Primitives and voxelization
+# Bands, rooms, navigability
 # ---------------------------------------------------------------------------
-
-
-def _prim_row(center, rot, half, quad) -> np.ndarray:
-    row = np.empty(N_PRIM_COLUMNS, dtype=np.float64)
-    row[0:3] = center
-    row[3:12] = np.asarray(rot, dtype=np.float64).reshape(9)
-    row[12:15] = half
-    row[15:18] = quad
-    return row
-
-
-def geom_prims(model: mujoco.MjModel, data: mujoco.MjData, geom: int) -> list[np.ndarray]:
-    """Exact primitives (rows of :data:`PRIM_COLUMNS`) of one primitive geom.
-
-    Returns an empty list for planes, meshes and other non-primitive types.
-    """
-    t = int(model.geom_type[geom])
-    s = model.geom_size[geom].astype(np.float64)
-    c = data.geom_xpos[geom].astype(np.float64)
-    R = data.geom_xmat[geom].reshape(3, 3).astype(np.float64)
-    G = mujoco.mjtGeom
-    if t == G.mjGEOM_BOX:
-        return [_prim_row(c, R, s, (0.0, 0.0, 0.0))]
-    if t == G.mjGEOM_SPHERE:
-        r = s[0]
-        return [_prim_row(c, R, (r, r, r), (1 / r**2,) * 3)]
-    if t == G.mjGEOM_ELLIPSOID:
-        return [_prim_row(c, R, s, 1.0 / s**2)]
-    if t == G.mjGEOM_CYLINDER:
-        r, h = s[0], s[1]
-        return [_prim_row(c, R, (r, r, h), (1 / r**2, 1 / r**2, 0.0))]
-    if t == G.mjGEOM_CAPSULE:
-        r, h = s[0], s[1]
-        axis = R[:, 2]
-        return [
-            _prim_row(c, R, (r, r, h), (1 / r**2, 1 / r**2, 0.0)),
-            _prim_row(c + h * axis, R, (r, r, r), (1 / r**2,) * 3),
-            _prim_row(c - h * axis, R, (r, r, r), (1 / r**2,) * 3),
-        ]
-    return []
-
-
-def _geom_visible(model: mujoco.MjModel, geom: int) -> bool:
-    """Whether ``mj_ray`` can hit the geom (it skips fully transparent geoms)."""
-    mat = int(model.geom_matid[geom])
-    if mat >= 0:
-        return bool(model.mat_rgba[mat, 3] != 0)
-    return bool(model.geom_rgba[geom, 3] != 0)
-
-
-class _Voxelizer:
-    """Marks voxels overlapped by boxes and triangles on a (Z, H, W) grid."""
-
-    def __init__(self, origin: np.ndarray, shape: tuple[int, int], n_slices: int, res: float, dz: float):
-        self.lo = np.array([origin[0], origin[1], 0.0])
-        self.cell = np.array([res, res, dz])
-        self.dims = np.array([shape[1], shape[0], n_slices])  # x, y, z counts
-
-    def _range(self, lo, hi):
-        i0 = np.floor((lo - self.lo) / self.cell).astype(np.int64)
-        i1 = np.floor((hi - self.lo) / self.cell).astype(np.int64)
-        return np.maximum(i0, 0), np.minimum(i1, self.dims - 1)
-
-    def box(self, center, rot, half) -> tuple[np.ndarray, np.ndarray]:
-        """Voxels overlapping an oriented box (separating-axis test).
-
-        Returns:
-            idx: (M, 3) voxel (ix, iy, iz) indices overlapping the box; an
-                upright box is grown by :data:`_TOUCH` vertically (a voxel its
-                top or bottom face merely touches is included, for horizontal
-                rays at exactly that height), any other box in every direction.
-            strict: (M,) bool, the voxel overlaps the box shrunk by
-                :data:`_SHRINK` (what occupancy and navigation use).
-        """
-        center = np.asarray(center, dtype=np.float64)
-        rot = np.asarray(rot, dtype=np.float64).reshape(3, 3)
-        half = np.asarray(half, dtype=np.float64)
-        grown = half + _TOUCH
-        shrunk = np.maximum(half - _SHRINK, 0.0)
-        ext = np.abs(rot) @ grown
-        i0, i1 = self._range(center - ext, center + ext)
-        if np.any(i1 < i0):
-            return np.zeros((0, 3), np.int64), np.zeros(0, bool)
-        vh = self.cell / 2
-        if abs(abs(rot[2, 2]) - 1.0) < 1e-9:
-            # upright: 2-D separating axes in xy, exact z intervals
-            xs = np.arange(i0[0], i1[0] + 1)
-            ys = np.arange(i0[1], i1[1] + 1)
-            dx = (self.lo[0] + (xs + 0.5) * self.cell[0])[None, :] - center[0]
-            dy = (self.lo[1] + (ys + 0.5) * self.cell[1])[:, None] - center[1]
-            u, v = rot[:2, 0], rot[:2, 1]
-            ok_s = np.ones((len(ys), len(xs)), bool)
-            for ax in (np.array([1.0, 0.0]), np.array([0.0, 1.0]), u, v):
-                sep = np.abs(dx * ax[0] + dy * ax[1]) - (vh[0] * abs(ax[0]) + vh[1] * abs(ax[1]))
-                ok_s &= sep <= shrunk[0] * abs(ax @ u) + shrunk[1] * abs(ax @ v)
-            yy, xx = np.nonzero(ok_s)
-            if len(xx) == 0:
-                return np.zeros((0, 3), np.int64), np.zeros(0, bool)
-            zs = np.arange(i0[2], i1[2] + 1)
-            zc = self.lo[2] + (zs + 0.5) * self.cell[2]
-            z_s = np.abs(zc - center[2]) <= vh[2] + shrunk[2]
-            n = len(zs)
-            idx = np.stack([np.repeat(xs[xx], n), np.repeat(ys[yy], n), np.tile(zs, len(xx))], -1)
-            strict = np.tile(z_s, len(xx))
-            return idx, strict
-        grids = np.meshgrid(*[np.arange(a, b + 1) for a, b in zip(i0, i1)], indexing="ij")
-        idx = np.stack([g.ravel() for g in grids], -1)
-        d = self.lo + (idx + 0.5) * self.cell - center
-        # the 15 separating axes: world axes, box axes and their cross products
-        cross = np.cross(np.eye(3)[:, None, :], rot.T[None, :, :]).reshape(9, 3)
-        norm = np.linalg.norm(cross, axis=1)
-        axes = np.concatenate([np.eye(3), rot.T, cross[norm > 1e-9] / norm[norm > 1e-9, None]])  # Shape: (A, 3)
-        sep = np.abs(d @ axes.T) - np.abs(axes) @ vh  # Shape: (M, A)
-        proj = np.abs(axes @ rot)  # Shape: (A, 3): |axis . box axis j|
-        ok_g = np.all(sep <= proj @ grown, axis=1)
-        ok_s = np.all(sep <= proj @ shrunk, axis=1)
-        return idx[ok_g], ok_s[ok_g]
-
-    def sub_box(self, idx: np.ndarray, row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Quantised bounds (in 1/SUB_Q voxel) of a primitive's bounding box
-        (grown by :data:`_TOUCH`) within each voxel: (M, 3) low and high
-        quarter indices such that the box lies in ``[lo, hi + 1] / SUB_Q``."""
-        c, R, h = row[0:3], row[3:12].reshape(3, 3), row[12:15]
-        ext = np.abs(R) @ (h + _TOUCH)
-        v0 = self.lo + idx * self.cell
-        lo = np.clip((c - ext - v0) / self.cell, 0.0, 1.0)
-        hi = np.clip((c + ext - v0) / self.cell, 0.0, 1.0)
-        qlo = np.clip(np.floor(lo * SUB_Q), 0, SUB_Q - 1).astype(np.uint8)
-        qhi = np.clip(np.ceil(hi * SUB_Q) - 1, 0, SUB_Q - 1).astype(np.uint8)
-        return qlo, np.maximum(qhi, qlo)
-
-    def inside(self, idx: np.ndarray, row: np.ndarray) -> np.ndarray:
-        """(M,) bool: voxel lies entirely inside the primitive ``row`` (all
-        eight corners inside a convex set)."""
-        c, R, h, q = row[0:3], row[3:12].reshape(3, 3), row[12:15], row[15:18]
-        if len(idx) == 0 or 2 * h.min() + 2 * _SHRINK < self.cell.min():
-            return np.zeros(len(idx), bool)  # too thin to hold a whole voxel
-        corners = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)], np.float64)
-        pts = self.lo + (idx[:, None, :] + corners[None]) * self.cell  # Shape: (M, 8, 3)
-        loc = (pts - c) @ R  # local frame
-        ok = np.all(np.abs(loc) <= h + _SHRINK, axis=-1) & ((loc**2 * q).sum(-1) <= 1.0 + 1e-9)
-        return ok.all(1)
-
-    def triangles(self, verts: np.ndarray, faces: np.ndarray) -> np.ndarray:
-        """(M, 3) voxel indices hit by samples of the triangles (spacing < 0.4 voxel)."""
-        spacing = 0.4 * float(self.cell.min())
-        a, b, c = verts[faces[:, 0]], verts[faces[:, 1]], verts[faces[:, 2]]
-        edge = np.maximum.reduce([np.linalg.norm(b - a, axis=1), np.linalg.norm(c - b, axis=1),
-                                  np.linalg.norm(a - c, axis=1)])
-        n_sub = np.maximum(np.ceil(edge / spacing).astype(np.int64), 1)
-        out = []
-        for n in np.unique(n_sub):
-            sel = n_sub == n
-            i, j = np.mgrid[0:n + 1, 0:n + 1]
-            keep = i + j <= n
-            u = (i[keep] / n)[None, :, None]
-            v = (j[keep] / n)[None, :, None]
-            pts = a[sel, None] + u * (b[sel, None] - a[sel, None]) + v * (c[sel, None] - a[sel, None])
-            out.append(pts.reshape(-1, 3))
-        pts = np.concatenate(out) if out else np.zeros((0, 3))
-        idx = np.floor((pts - self.lo) / self.cell).astype(np.int64)
-        ok = np.all((idx >= 0) & (idx < self.dims), axis=1)
-        return np.unique(idx[ok], axis=0)
-
-
-def _mesh_world(model: mujoco.MjModel, data: mujoco.MjData, geom: int) -> tuple[np.ndarray, np.ndarray]:
-    mid = int(model.geom_dataid[geom])
-    v0, nv = int(model.mesh_vertadr[mid]), int(model.mesh_vertnum[mid])
-    f0, nf = int(model.mesh_faceadr[mid]), int(model.mesh_facenum[mid])
-    verts = model.mesh_vert[v0:v0 + nv].astype(np.float64)
-    faces = model.mesh_face[f0:f0 + nf].astype(np.int64)
-    R = data.geom_xmat[geom].reshape(3, 3)
-    return verts @ R.T + data.geom_xpos[geom], faces
-
-
-def _watertight(faces: np.ndarray) -> bool:
-    e = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
-    e = np.sort(e, axis=1)
-    _, counts = np.unique(e, axis=0, return_counts=True)
-    return bool(len(counts) and np.all(counts == 2))
-
-
-def _fill_inside(vox: np.ndarray) -> np.ndarray:
-    """Fill the enclosed interior of a voxelized closed surface."""
-    if len(vox) == 0:
-        return vox
-    lo = vox.min(0)
-    hi = vox.max(0)
-    block = np.zeros(tuple(hi - lo + 1), bool)
-    block[tuple((vox - lo).T)] = True
-    filled = ndimage.binary_fill_holes(block)
-    return np.argwhere(filled) + lo
-
-
-def _scene_extent(compiled, config: GridConfig) -> tuple[np.ndarray, tuple[int, int], int]:
-    """Grid origin, (H, W) and number of slices covering the scene."""
-    scene: Scene = compiled.scene
-    lo, hi = scene.bounds()
-    model, data = compiled.model, compiled.data
-    top = float(hi[2]) if len(scene.rooms) else 0.0
-    for g in range(model.ngeom):
-        if int(model.geom_group[g]) not in config.ray_groups or model.geom_type[g] == mujoco.mjtGeom.mjGEOM_PLANE:
-            continue
-        if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH:
-            verts, _ = _mesh_world(model, data, g)
-            if len(verts) == 0:
-                continue
-            glo, ghi = verts.min(0), verts.max(0)
-        else:
-            rows = geom_prims(model, data, g)
-            if not rows:
-                continue
-            ext = np.stack([np.abs(r[3:12].reshape(3, 3)) @ r[12:15] for r in rows])
-            ctr = np.stack([r[0:3] for r in rows])
-            glo, ghi = (ctr - ext).min(0), (ctr + ext).max(0)
-        lo[:2] = np.minimum(lo[:2], glo[:2])
-        hi[:2] = np.maximum(hi[:2], ghi[:2])
-        top = max(top, float(ghi[2]))
-    res = config.resolution
-    origin = np.floor((lo[:2] - config.margin) / res + 1e-9) * res
-    far = np.ceil((hi[:2] + config.margin) / res - 1e-9) * res
-    W = max(int(round((far[0] - origin[0]) / res)), 1)
-    H = max(int(round((far[1] - origin[1]) / res)), 1)
-    if config.max_height is not None:
-        height = config.max_height
-    else:
-        lb = config.list_band_height
-        height = max(math.ceil(top / lb - 1e-9), 1) * lb
-    n_slices = max(int(math.ceil(height / config.slice_height - 1e-9)), 1)
-    return origin, (H, W), n_slices
-
-
-def _voxelize(compiled, config: GridConfig, origin, shape, n_slices):
-    """Occupancy, exact primitives and their (column, list band) memberships."""
-    model, data = compiled.model, compiled.data
-    H, W = shape
-    vz = _Voxelizer(origin, shape, n_slices, config.resolution, config.slice_height)
-    occ = np.zeros((n_slices, H, W), bool)
-    occ_ray = np.zeros((n_slices, H, W), bool)
-    full = np.zeros((n_slices, H, W), bool)
-    sub_lo = np.full((n_slices, H, W, 3), SUB_Q - 1, np.uint8)
-    sub_hi = np.zeros((n_slices, H, W, 3), np.uint8)
-    spb = config.slices_per_list_band
-    n_lb = -(-n_slices // spb)
-    prims: list[np.ndarray] = []
-    prim_geom: list[int] = []
-    keys: list[np.ndarray] = []  # (column-segment key, prim index or -1 for meshes)
-    vals: list[np.ndarray] = []
-    mesh_keys: list[np.ndarray] = []
-    G = mujoco.mjtGeom
-    for g in range(model.ngeom):
-        if int(model.geom_group[g]) not in config.ray_groups or not _geom_visible(model, g):
-            continue
-        t = int(model.geom_type[g])
-        if t == G.mjGEOM_PLANE:
-            continue
-        if t == G.mjGEOM_MESH:
-            verts, faces = _mesh_world(model, data, g)
-            vox = vz.triangles(verts, faces)
-            if int(model.geom_group[g]) == 2 and _watertight(faces):
-                vox = _fill_inside(vox)
-            if len(vox):
-                occ[vox[:, 2], vox[:, 1], vox[:, 0]] = True
-                occ_ray[vox[:, 2], vox[:, 1], vox[:, 0]] = True
-                sub_lo[vox[:, 2], vox[:, 1], vox[:, 0]] = 0
-                sub_hi[vox[:, 2], vox[:, 1], vox[:, 0]] = SUB_Q - 1
-                mesh_keys.append(np.unique((vox[:, 1] * W + vox[:, 0]) * n_lb + vox[:, 2] // spb))
-            continue
-        for row in geom_prims(model, data, g):
-            vox, strict = vz.box(row[0:3], row[3:12], row[12:15])
-            p = len(prims)
-            prims.append(row)
-            prim_geom.append(g)
-            if len(vox) == 0:
-                continue
-            occ_ray[vox[:, 2], vox[:, 1], vox[:, 0]] = True
-            qlo, qhi = vz.sub_box(vox, row)
-            at = (vox[:, 2], vox[:, 1], vox[:, 0])
-            np.minimum.at(sub_lo, at, qlo)
-            np.maximum.at(sub_hi, at, qhi)
-            sv = vox[strict]
-            occ[sv[:, 2], sv[:, 1], sv[:, 0]] = True
-            inner = sv[vz.inside(sv, row)]
-            full[inner[:, 2], inner[:, 1], inner[:, 0]] = True
-            k = np.unique((vox[:, 1] * W + vox[:, 0]) * n_lb + vox[:, 2] // spb)
-            keys.append(k)
-            vals.append(np.full(len(k), p, np.int64))
-    K = config.max_list
-    n_seg = H * W * n_lb
-    approx = np.zeros(n_seg, bool)
-    if keys:
-        key = np.concatenate(keys)
-        val = np.concatenate(vals)
-        order = np.lexsort((val, key))
-        key, val = key[order], val[order]
-        count = np.bincount(key, minlength=n_seg)
-        approx |= count > K
-        keep = ~approx[key]
-        key, val = key[keep], val[keep]
-        count = np.bincount(key, minlength=n_seg)
-        start = np.concatenate([[0], np.cumsum(count)[:-1]])
-        seg_prims = val.astype(np.int32)
-    else:
-        count = np.zeros(n_seg, np.int64)
-        start = np.zeros(n_seg, np.int64)
-        seg_prims = np.zeros(0, np.int32)
-    if mesh_keys:
-        approx[np.concatenate(mesh_keys)] = True
-    prim_arr = np.stack(prims).astype(np.float32) if prims else np.zeros((0, N_PRIM_COLUMNS), np.float32)
-    seg = (start.astype(np.int32).reshape(H, W, n_lb), count.astype(np.uint8).reshape(H, W, n_lb), seg_prims)
-    sub = pack_sub_boxes(sub_lo, sub_hi)
-    sub[~occ_ray] = 0
-    return occ, occ_ray, full, sub, prim_arr, np.asarray(prim_geom, np.int32), seg, approx.reshape(H, W, n_lb)
-
-
-SUB_Q = 4
-"""Sub-voxel quantisation of :attr:`NavGrid.sub_box` (quarters of a voxel)."""
-
-
-def pack_sub_boxes(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """Pack per-voxel sub-boxes into uint16.
-
-    Args:
-        lo, hi: (..., 3) uint8 quarter indices 0..3 along (x, y, z): the
-            geometry in a voxel lies within ``[lo / 4, (hi + 1) / 4]`` of it
-            along each axis (a conservative bound of the primitives' bounding
-            boxes clipped to the voxel).
-
-    Returns:
-        (...) uint16: bits ``2a`` and ``2a + 1`` hold ``lo[a]``, bits
-        ``6 + 2a`` and ``7 + 2a`` hold ``hi[a]``.
-    """
-    lo = lo.astype(np.uint16)
-    hi = hi.astype(np.uint16)
-    return (lo[..., 0] | lo[..., 1] << 2 | lo[..., 2] << 4 | hi[..., 0] << 6 | hi[..., 1] << 8
-            | hi[..., 2] << 10).astype(np.uint16)
-
-
-def march_codes(occupied: np.ndarray, touched: np.ndarray, full: np.ndarray) -> np.ndarray:
-    """Voxel codes of the fast ray march, (Z, H, W) uint8.
-
-    ``0`` (:data:`VOX_PARTIAL`): partly occupied (the ray tests the
-    primitives exactly); ``1`` (:data:`VOX_FULL`): entirely inside one
-    primitive (a ray entering it from free space hits its face exactly
-    there); ``2`` (:data:`VOX_TOUCH`): free, but a primitive's face touches it
-    (the ray tests it like a partly occupied voxel, for rays lying exactly in
-    that face's plane); ``c >= 3``: free, and the chessboard distance (voxel
-    index units) to the nearest voxel of the other kinds is ``c - 2``, so
-    every voxel within ``c - 3`` of it is free (clipped to :data:`FREE_MAX`).
-    Occupancy is ``code <= 1``.
-
-    Args:
-        occupied: (Z, H, W) bool, geometry overlaps the voxel.
-        touched: (Z, H, W) bool, geometry overlaps or touches it.
-        full: (Z, H, W) bool, the voxel lies inside one primitive.
-    """
-    touched = touched | occupied
-    if touched.any():
-        cheb = ndimage.distance_transform_cdt(~touched, metric="chessboard")
-        cheb = np.minimum(cheb, FREE_MAX)
-    else:
-        cheb = np.full(touched.shape, FREE_MAX)
-    code = (cheb + 2).astype(np.uint8)
-    code[touched] = VOX_TOUCH
-    code[occupied] = VOX_PARTIAL
-    code[full & occupied] = VOX_FULL
-    return code
 
 
 def _band_occupancy(occ: np.ndarray, config: GridConfig) -> np.ndarray:
@@ -744,8 +329,8 @@ def build_navgrid(compiled, config: GridConfig = GridConfig()) -> NavGrid:
     if not isinstance(config, GridConfig):
         raise ConfigError(None, "config", f"expected GridConfig, got {type(config).__name__}")
     scene: Scene = compiled.scene
-    origin, shape, n_slices = _scene_extent(compiled, config)
-    occ, occ_ray, full, sub_box, prims, prim_geom, (seg_start, seg_count, seg_prims), approx = _voxelize(
+    origin, shape, n_slices = scene_extent(compiled, config)
+    occ, occ_ray, full, sub_box, prims, prim_geom, (seg_start, seg_count, seg_prims), approx = voxelize(
         compiled, config, origin, shape, n_slices)
     bands = _band_occupancy(occ, config)
     obstacle = bands.any(0)
@@ -827,218 +412,3 @@ def check_reachable(scene: Scene, grid: NavGrid, path: str | None = None) -> Non
         f"rooms not reachable from the others for an agent of radius {grid.config.agent_radius} m: "
         + "; ".join(parts) + (f" (reachable: {', '.join(reached)})" if reached else ""),
     )
-
-
-# ---------------------------------------------------------------------------
-# Geodesic distance fields (JAX)
-# ---------------------------------------------------------------------------
-
-
-_REL_TOL = 4e-7  # about 3 float32 ulps
-
-
-def _sweep(d: jax.Array, w: jax.Array, axis: int, reverse: bool) -> jax.Array:
-    """One directional relaxation pass along ``axis`` (a ``lax.scan``).
-
-    ``w[i]`` is the cost of the edge from element ``i - 1`` (``i + 1`` when
-    ``reverse``) to element ``i`` along ``axis``, +inf when absent; the pass
-    computes ``d'[i] = min(d[i], d'[i -/+ 1] + w[i])``, so it relaxes a whole
-    straight run of cells at once.
-    """
-    dm = jnp.moveaxis(d, axis, 0)
-    wm = jnp.moveaxis(w, axis, 0)
-
-    def step(prev, x):
-        di, wi = x
-        cur = jnp.minimum(di, prev + wi)
-        return cur, cur
-
-    _, out = jax.lax.scan(step, jnp.full(dm.shape[1:], jnp.inf, dm.dtype), (dm, wm), reverse=reverse)
-    return jnp.moveaxis(out, 0, axis)
-
-
-def _skew_index(H: int, W: int, anti: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Gather/scatter indices that put the diagonals of an (H, W) grid into
-    the columns of an (H, H + W - 1) array."""
-    r = np.arange(H)[:, None]
-    s = np.arange(H + W - 1)[None, :]
-    c = (s - r) if anti else (s - (H - 1) + r)
-    valid = (c >= 0) & (c < W)
-    flat = np.where(valid, r * W + np.clip(c, 0, W - 1), H * W)  # H*W: the padding element
-    rr, cc = np.mgrid[0:H, 0:W]
-    back = rr * (H + W - 1) + ((cc + rr) if anti else (cc - rr + H - 1))
-    return flat, back
-
-
-def _edge_costs(nav: jax.Array, res: float):
-    """Costs of the 8 move directions into each cell, +inf where not allowed."""
-    inf = jnp.float32(jnp.inf)
-    H, W = nav.shape
-    n = nav
-    pad = jnp.pad(n, 1)  # False outside
-    up = pad[:-2, 1:-1]  # neighbour at row - 1
-    down = pad[2:, 1:-1]  # row + 1
-    left = pad[1:-1, :-2]  # col - 1
-    right = pad[1:-1, 2:]  # col + 1
-    ul = pad[:-2, :-2]
-    ur = pad[:-2, 2:]
-    dl = pad[2:, :-2]
-    dr = pad[2:, 2:]
-    o = jnp.float32(res)
-    g = jnp.float32(res * math.sqrt(2.0))
-    c = lambda m, cost: jnp.where(n & m, cost, inf)  # noqa: E731
-    return {
-        "from_left": c(left, o), "from_right": c(right, o), "from_up": c(up, o), "from_down": c(down, o),
-        # diagonal from (r-1, c-1): needs (r-1, c) and (r, c-1)
-        "from_ul": c(ul & up & left, g), "from_ur": c(ur & up & right, g),
-        "from_dl": c(dl & down & left, g), "from_dr": c(dr & down & right, g),
-    }
-
-
-def geodesic_field(navigable: jax.Array, seeds: jax.Array, resolution: float,
-                   max_rounds: int | None = None) -> jax.Array:
-    """Geodesic distance from seed cells over the navigable grid.
-
-    The graph is the 8-connected grid of navigable cells: orthogonal steps
-    cost ``resolution``, diagonal steps ``resolution * sqrt(2)`` and are
-    allowed only when both orthogonal neighbours they pass are navigable (no
-    corner cutting). The result is ``min over seeds s of seeds[s] +
-    path_length(s, cell)``.
-
-    Each ``lax.while_loop`` iteration runs eight directional min-plus sweeps
-    (left-right, right-left, down, up and the four diagonals, each a
-    ``lax.scan`` of ``d[i] = min(d[i], d[i - 1] + w[i])`` over rows, columns
-    or diagonals), so a straight stretch of any length is relaxed in one
-    iteration; iteration stops when a round changes nothing (beyond float32
-    rounding of equal-length paths, a relative 4e-7), the fixed point of
-    Bellman-Ford: the same distances as Dijkstra up to float32 rounding.
-    A 10-room house (about 250 x 270 cells) takes about a dozen rounds.
-
-    Args:
-        navigable: (H, W) bool.
-        seeds: (H, W) float32 initial cost at seed cells, +inf elsewhere;
-            seeds on non-navigable cells are ignored.
-        resolution: cell size, metres (static).
-        max_rounds: optional cap on the rounds (None: H * W, never reached).
-
-    Returns:
-        (H, W) float32 distances in metres, +inf where no seed is reachable
-        (and on every non-navigable cell).
-
-    Jit-able and vmappable (e.g. over seeds for many targets at once).
-    """
-    with jax.named_scope("geodesic_field"):
-        nav = jnp.asarray(navigable, bool)
-        H, W = nav.shape
-        inf = jnp.float32(jnp.inf)
-        d0 = jnp.where(nav, jnp.asarray(seeds, jnp.float32), inf)
-        w = _edge_costs(nav, resolution)
-        # diagonals as columns of skewed arrays. Shape: (H, H + W - 1)
-        fwd_flat, fwd_back = _skew_index(H, W, anti=False)  # cells with c - r constant
-        anti_flat, anti_back = _skew_index(H, W, anti=True)  # cells with c + r constant
-
-        def skew(a, flat):
-            return jnp.concatenate([a.reshape(-1), jnp.full((1,), inf, a.dtype)])[flat]
-
-        def unskew(a, back):
-            return a.reshape(-1)[back]
-
-        w_ul = skew(w["from_ul"], fwd_flat)
-        w_dr = skew(w["from_dr"], fwd_flat)
-        w_ur = skew(w["from_ur"], anti_flat)
-        w_dl = skew(w["from_dl"], anti_flat)
-
-        def one_round(d):
-            d = _sweep(d, w["from_left"], axis=1, reverse=False)
-            d = _sweep(d, w["from_right"], axis=1, reverse=True)
-            d = _sweep(d, w["from_up"], axis=0, reverse=False)
-            d = _sweep(d, w["from_down"], axis=0, reverse=True)
-            s = skew(d, fwd_flat)
-            s = _sweep(s, w_ul, axis=0, reverse=False)
-            s = _sweep(s, w_dr, axis=0, reverse=True)
-            d = unskew(s, fwd_back)
-            s = skew(d, anti_flat)
-            s = _sweep(s, w_ur, axis=0, reverse=False)
-            s = _sweep(s, w_dl, axis=0, reverse=True)
-            return unskew(s, anti_back)
-
-        cap = H * W if max_rounds is None else int(max_rounds)
-
-        def cond(state):
-            _, changed, i = state
-            return changed & (i < cap)
-
-        def body(state):
-            d, _, i = state
-            nd = one_round(d)
-            # float sums of equal-length paths differ in the last bits; ignore such changes
-            return nd, jnp.any(nd < jnp.where(jnp.isinf(d), d, d - _REL_TOL * d)), i + 1
-
-        d, _, _ = jax.lax.while_loop(cond, body, (d0, jnp.array(True), jnp.array(0, jnp.int32)))
-        return d
-
-
-def seeds_from_box(navigable: jax.Array, room: jax.Array, origin: jax.Array, resolution: float,
-                   center: jax.Array, half_extents: jax.Array, yaw: jax.Array, room_index: jax.Array,
-                   seed_radius: float) -> jax.Array:
-    """Seeds (initial costs) for the geodesic distance to an object (jnp).
-
-    Seed cells are the navigable cells of the object's room whose centres lie
-    within ``seed_radius`` of the object's floor footprint; each is seeded
-    with its 2-D distance to the footprint. When no cell qualifies, the
-    room's navigable cells nearest the footprint (within one cell of the
-    minimum distance) are used instead. ``room_index < 0`` allows every room.
-
-    Args:
-        navigable: (H, W) bool.
-        room: (H, W) int32 room-id grid.
-        origin: (2,) grid origin (world x, y of cell (0, 0)'s corner).
-        resolution: cell size, metres.
-        center: (3,) or (2,) box centre, world.
-        half_extents: (3,) or (2,) box half sizes along its own x, y.
-        yaw: () box yaw, radians.
-        room_index: () int32 index of the object's room, -1 for any.
-        seed_radius: metres.
-
-    Returns:
-        (H, W) float32 seeds, +inf where not a seed.
-    """
-    H, W = navigable.shape
-    inf = jnp.float32(jnp.inf)
-    xs = origin[0] + (jnp.arange(W, dtype=jnp.float32) + 0.5) * resolution  # Shape: (W,)
-    ys = origin[1] + (jnp.arange(H, dtype=jnp.float32) + 0.5) * resolution  # Shape: (H,)
-    dx = xs[None, :] - center[0]
-    dy = ys[:, None] - center[1]
-    c, s = jnp.cos(yaw), jnp.sin(yaw)
-    lx = dx * c + dy * s
-    ly = -dx * s + dy * c
-    ex = jnp.maximum(jnp.abs(lx) - half_extents[0], 0.0)
-    ey = jnp.maximum(jnp.abs(ly) - half_extents[1], 0.0)
-    dist = jnp.sqrt(ex**2 + ey**2).astype(jnp.float32)  # Shape: (H, W)
-    allowed = navigable & ((room == room_index) | (room_index < 0))
-    near = allowed & (dist <= seed_radius)
-    dmin = jnp.min(jnp.where(allowed, dist, inf))
-    fallback = allowed & (dist <= dmin + resolution)
-    mask = jnp.where(jnp.any(near), near, fallback)
-    return jnp.where(mask, dist, inf)
-
-
-_seeds_jit = jax.jit(seeds_from_box, static_argnums=(3, 8))
-
-
-def target_seeds(grid: NavGrid, bbox: OrientedBox, room_index: int | None, seed_radius: float = 1.0) -> np.ndarray:
-    """Seeds for the geodesic distance to an object on a :class:`NavGrid`.
-
-    See :func:`seeds_from_box`; ``room_index`` indexes ``grid.room_ids``
-    (None or -1: any room).
-
-    Returns:
-        (H, W) float32 seeds, +inf where not a seed.
-    """
-    ri = -1 if room_index is None else int(room_index)
-    out = _seeds_jit(
-        jnp.asarray(grid.navigable), jnp.asarray(grid.room), jnp.asarray(grid.origin, jnp.float32),
-        grid.resolution, jnp.asarray(bbox.center, jnp.float32), jnp.asarray(bbox.half_extents, jnp.float32),
-        jnp.float32(bbox.yaw), jnp.int32(ri), float(seed_radius),
-    )
-    return np.asarray(out)

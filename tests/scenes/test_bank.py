@@ -8,15 +8,18 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+from ignjax.bench.rays import agreement, random_rays, ray_groups_mask
 from ignjax.errors import ConfigError
 from ignjax.scenes import vocab
 from ignjax.scenes.bank import SceneBank, field_at, target_fields
+from ignjax.scenes.geodesic import geodesic_field, goal_fields, target_seeds
 from ignjax.scenes.graph import room_adjacency
-from ignjax.scenes.navgrid import geodesic_field, target_seeds
 from ignjax.scenes.procgen.generate import HouseParams, generate_house
-from ignjax.sim.rays import caster as rc
+from ignjax.scenes.raygrid import ray_grid
+from ignjax.sim.rays.exact import mj_rays
+from ignjax.sim.rays.fast import fast_ray_hit, fast_rays
 
-GROUPS = rc.ray_groups_mask((1, 2, 3))
+GROUPS = ray_groups_mask((1, 2, 3))
 N_RAYS = 1536  # rays per scene
 
 
@@ -33,7 +36,7 @@ def episode_rays(bank):
     rng = np.random.default_rng(0)
     p, v, s = [], [], []
     for i in range(bank.n_scenes):
-        pi, vi = rc.random_rays(bank.navgrids[i], N_RAYS // 16, 16, rng)
+        pi, vi = random_rays(bank.navgrids[i], N_RAYS // 16, 16, rng)
         p.append(pi)
         v.append(vi)
         s.append(np.full(len(pi), i, np.int32))
@@ -44,13 +47,13 @@ def episode_rays(bank):
 @pytest.fixture(scope="module")
 def per_ray():
     """vmap of the per-ray fast ray over episodes; the ray grid is unbatched."""
-    return jax.jit(jax.vmap(lambda g, p, v, s: rc.fast_ray_hit(g, p, v, 5.0, s), in_axes=(None, 0, 0, 0)))
+    return jax.jit(jax.vmap(lambda g, p, v, s: fast_ray_hit(g, p, v, 5.0, s), in_axes=(None, 0, 0, 0)))
 
 
 @pytest.fixture(scope="module")
 def batched():
     """The staged batch path with a scene index per ray (compiled once: always N rays)."""
-    f = jax.jit(lambda g, p, v, s: rc.fast_rays(g, p, v, 5.0, s, want_geom=True))
+    f = jax.jit(lambda g, p, v, s: fast_rays(g, p, v, 5.0, s, want_geom=True))
 
     def run(grid, pnts, vecs, scenes):
         n = len(pnts)
@@ -163,13 +166,13 @@ def test_fast_rays_over_episodes_equal_per_scene(bank, episode_rays, per_ray, ba
     d_bank, g_bank = batched(bank.rays, pnts, vecs, scenes)
     for s in range(bank.n_scenes):
         m = scenes == s
-        ref, _ = rc.mj_rays(bank.compiled[s], pnts[m], vecs[m], GROUPS)
-        assert rc.agreement(d_bank[m], ref, 5.0, bank.config.resolution).mean() >= 0.995
+        ref, _ = mj_rays(bank.compiled[s], pnts[m], vecs[m], GROUPS)
+        assert agreement(d_bank[m], ref, 5.0, bank.config.resolution).mean() >= 0.995
     # the smallest scene with its own, unpadded ray grid gives the same numbers
     # (through the vmapped per-ray path: the staged batch path equals it)
     s = int(np.argmin([g.shape[0] * g.shape[1] for g in bank.navgrids]))
     m = scenes == s
-    own = rc.ray_grid(bank.navgrids[s], bank.compiled[s])
+    own = ray_grid(bank.navgrids[s], bank.compiled[s])
     d_own, g_own = per_ray(own, jnp.asarray(pnts[m], jnp.float32), jnp.asarray(vecs[m], jnp.float32),
                            jnp.zeros(int(m.sum()), jnp.int32))
     np.testing.assert_allclose(d_bank[m], np.asarray(d_own), atol=1e-5)
@@ -193,8 +196,8 @@ def test_padding_creates_no_hits(bank, batched):
     yaw = rng.uniform(-np.pi, np.pi, n)
     vecs = np.column_stack([np.cos(yaw), np.sin(yaw), np.zeros(n)])
     d, _ = batched(bank.rays, pnts, vecs, np.full(n, s, np.int32))
-    ref, _ = rc.mj_rays(bank.compiled[s], pnts, vecs, GROUPS)
-    ok = rc.agreement(d, ref, 5.0, g.resolution)
+    ref, _ = mj_rays(bank.compiled[s], pnts, vecs, GROUPS)
+    ok = agreement(d, ref, 5.0, g.resolution)
     assert ok[: n // 2].all()  # out in the padding: nothing there but (maybe) the floor's edge
     assert ok.mean() >= 0.995
 
@@ -227,3 +230,21 @@ def test_geodesic_fields_from_bank_equal_per_scene(bank):
     assert float(field_at(bank, jnp.asarray(fields[0]), s, jnp.asarray(xy, jnp.float32))) == \
         pytest.approx(fields[0][rc_[0], rc_[1]])
     assert np.isinf(float(field_at(bank, jnp.asarray(fields[0]), s, jnp.asarray([-100.0, -100.0]))))
+
+
+def test_goal_fields_equal_bank_fields_bytewise(bank):
+    """goal_fields (one scene's grid padded to multiples of 32 cells, what the
+    episode loader and construction use) gives the bank's target_fields (the
+    bank's padded grid) byte for byte: the padding never changes a field."""
+    rooms = np.asarray(bank.instances.room)
+    per_bank = jax.jit(lambda b, s, i: target_fields(b, s, i, 1.0))
+    H, W = bank.grid.navigable.shape[1:]
+    for s in range(bank.n_scenes):
+        idx = list(range(min(4, len(bank.scene(s).instances))))
+        g = bank.navgrids[s]
+        own = goal_fields(g, [bank.scene(s).instances[i].bbox for i in idx], [int(rooms[s, i]) for i in idx], 1.0)
+        ref = np.asarray(per_bank(bank, jnp.full(len(idx), s, jnp.int32), jnp.asarray(idx, jnp.int32)))
+        padded = np.full((len(idx), H, W), np.inf, np.float32)
+        padded[:, :g.shape[0], :g.shape[1]] = own
+        assert padded.tobytes() == ref.tobytes()
+        assert np.isfinite(own).any()

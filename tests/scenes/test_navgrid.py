@@ -17,9 +17,9 @@ from scipy.spatial import cKDTree
 
 from ignjax.errors import ConfigError, SceneError
 from ignjax.scenes.compile import compile_scene
+from ignjax.scenes.geodesic import geodesic_field, target_seeds
 from ignjax.scenes.model import Attributes, Geom, Instance, OrientedBox
-from ignjax.scenes.navgrid import (GridConfig, build_navgrid, check_reachable, geodesic_field, target_seeds,
-                                   unreachable_rooms)
+from ignjax.scenes.navgrid import GridConfig, build_navgrid, check_reachable, unreachable_rooms
 from ignjax.scenes.procgen.generate import HouseParams, generate_house
 
 RAY_GROUPS = np.array([0, 1, 1, 1, 0, 0], np.uint8)  # what the grid voxelizes: walls, objects, structural

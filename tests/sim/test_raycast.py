@@ -12,25 +12,29 @@ import numpy as np
 import pytest
 from mujoco import mjx
 
+from ignjax.bench.rays import agreement, benchmark_rays, random_rays, ray_groups_mask
 from ignjax.scenes.compile import compile_scene
-from ignjax.scenes.navgrid import build_navgrid, geom_prims
+from ignjax.scenes.navgrid import build_navgrid
 from ignjax.scenes.procgen.generate import HouseParams, generate_house
-from ignjax.sim.rays import caster as rc
+from ignjax.scenes.raygrid import ray_grid
+from ignjax.scenes.voxels import geom_prims
+from ignjax.sim.rays.exact import exact_rays, mj_multiray, mj_rays
+from ignjax.sim.rays.fast import fast_ray_hit, line_of_sight, prim_hit
 
-GROUPS = rc.ray_groups_mask((1, 2, 3))  # floor, walls, objects, structural
+GROUPS = ray_groups_mask((1, 2, 3))  # floor, walls, objects, structural
 
 
 @pytest.fixture(scope="module")
 def per_ray_jit():
     """vmap of the per-ray fast_ray_hit (grid unbatched): one compilation per grid."""
-    return jax.jit(jax.vmap(lambda g, p, v, m: rc.fast_ray_hit(g, p, v, m), in_axes=(None, 0, 0, None)))
+    return jax.jit(jax.vmap(lambda g, p, v, m: fast_ray_hit(g, p, v, m), in_axes=(None, 0, 0, None)))
 
 
 @pytest.fixture(scope="module")
 def two_room(two_room_scene):
     compiled = compile_scene(two_room_scene)
     grid = build_navgrid(compiled)
-    return compiled, grid, rc.ray_grid(grid, compiled)
+    return compiled, grid, ray_grid(grid, compiled)
 
 
 @pytest.fixture(scope="module")
@@ -38,7 +42,7 @@ def house():
     scene = generate_house(11, HouseParams(n_rooms=6))
     compiled = compile_scene(scene)
     grid = build_navgrid(compiled)
-    return compiled, grid, rc.ray_grid(grid, compiled)
+    return compiled, grid, ray_grid(grid, compiled)
 
 
 def _ids_match(compiled, pnts, vecs, g, ref, ref_id, tol=1e-4) -> np.ndarray:
@@ -73,7 +77,7 @@ def _cast(fn, rg, pnts, vecs, max_dist):
 
 
 def _rays(grid, n_origins, per_origin, seed, **kw):
-    return rc.random_rays(grid, n_origins, per_origin, np.random.default_rng(seed), **kw)
+    return random_rays(grid, n_origins, per_origin, np.random.default_rng(seed), **kw)
 
 
 # ---------------------------------------------------------------------------
@@ -106,7 +110,7 @@ def test_prim_hit_matches_mju_ray_geom():
     pnts[:40] = data.geom_xpos[rng.integers(0, model.ngeom, 40)]  # some from inside
     vecs = rng.normal(size=(300, 3))
     vecs /= np.linalg.norm(vecs, axis=1, keepdims=True)
-    hit = jax.jit(jax.vmap(jax.vmap(rc.prim_hit, in_axes=(0, None, None)), in_axes=(None, 0, 0)))
+    hit = jax.jit(jax.vmap(jax.vmap(prim_hit, in_axes=(0, None, None)), in_axes=(None, 0, 0)))
     got = np.asarray(hit(jnp.asarray(rows), jnp.asarray(pnts, jnp.float32), jnp.asarray(vecs, jnp.float32)))
     # a geom's distance is the minimum over its primitives (a capsule has three)
     per_geom = np.full((len(pnts), model.ngeom), np.inf)
@@ -134,9 +138,9 @@ def test_prim_hit_matches_mju_ray_geom():
 def test_exact_rays_match_mj_ray(two_room):
     compiled, grid, _ = two_room
     pnts, vecs = _rays(grid, 100, 20, seed=1)
-    for groups in (None, GROUPS, rc.ray_groups_mask((1,), include_floor=False)):
-        d, g = rc.exact_rays(compiled, pnts, vecs, groups)
-        ref, ref_id = rc.mj_rays(compiled, pnts, vecs, groups)
+    for groups in (None, GROUPS, ray_groups_mask((1,), include_floor=False)):
+        d, g = exact_rays(compiled, pnts, vecs, groups)
+        ref, ref_id = mj_rays(compiled, pnts, vecs, groups)
         d, g = np.asarray(d), np.asarray(g)
         assert np.array_equal(np.isinf(d), np.isinf(ref))
         fin = np.isfinite(ref)
@@ -153,12 +157,12 @@ def test_mjx_ray_ignores_cylinders_exact_rays_does_not(two_room):
     pnts, vecs = _rays(grid, 100, 20, seed=1)  # the batch shape test_exact_rays_match_mj_ray compiled
     pnts[0] = [c[0] - 0.5, c[1], c[2]]
     vecs[0] = [1.0, 0.0, 0.0]
-    ref, ref_id = rc.mj_rays(compiled, pnts[:1], vecs[:1])
+    ref, ref_id = mj_rays(compiled, pnts[:1], vecs[:1])
     assert ref_id[0] == leg
     raw = jax.jit(jax.vmap(lambda p, v: mjx.ray(compiled.mjx_model, compiled.mjx_data, p, v)))
     _, g_raw = raw(jnp.asarray(pnts[:8], jnp.float32), jnp.asarray(vecs[:8], jnp.float32))
     assert int(g_raw[0]) != leg
-    d, g = rc.exact_rays(compiled, pnts, vecs)
+    d, g = exact_rays(compiled, pnts, vecs)
     assert int(g[0]) == leg and float(d[0]) == pytest.approx(ref[0], abs=1e-5)
 
 
@@ -167,13 +171,13 @@ def test_mj_multiray_matches_mj_ray(two_room):
     pnts, vecs = _rays(grid, 5, 40, seed=2)
     for i in range(5):
         sl = slice(40 * i, 40 * (i + 1))
-        d, g = rc.mj_multiray(compiled, pnts[sl][0], vecs[sl], GROUPS)
-        ref, ref_id = rc.mj_rays(compiled, pnts[sl], vecs[sl], GROUPS)
+        d, g = mj_multiray(compiled, pnts[sl][0], vecs[sl], GROUPS)
+        ref, ref_id = mj_rays(compiled, pnts[sl], vecs[sl], GROUPS)
         np.testing.assert_allclose(d, ref)
         assert np.array_equal(g, ref_id)
     # the cutoff only culls geoms (by bounding sphere): hits within it are unchanged
-    d, _ = rc.mj_multiray(compiled, pnts[0], vecs[:40], GROUPS, cutoff=0.5)
-    ref, _ = rc.mj_rays(compiled, pnts[:40], vecs[:40], GROUPS)
+    d, _ = mj_multiray(compiled, pnts[0], vecs[:40], GROUPS, cutoff=0.5)
+    ref, _ = mj_rays(compiled, pnts[:40], vecs[:40], GROUPS)
     np.testing.assert_allclose(d[ref <= 0.5], ref[ref <= 0.5])
 
 
@@ -184,8 +188,8 @@ def test_mj_multiray_matches_mj_ray(two_room):
 
 def _agreement(fn, compiled, grid, rg, pnts, vecs, max_dist):
     d, g = _cast(fn, rg, pnts, vecs, max_dist)
-    ref, ref_id = rc.mj_rays(compiled, pnts, vecs, GROUPS)
-    ok = rc.agreement(d, ref, max_dist, grid.resolution)
+    ref, ref_id = mj_rays(compiled, pnts, vecs, GROUPS)
+    ok = agreement(d, ref, max_dist, grid.resolution)
     return ok, d, g, ref, ref_id
 
 
@@ -232,7 +236,7 @@ def test_fast_ray_hand_built(two_room, per_ray_jit):
     vecs = np.array([c[1] for c in cases], float)
     vecs /= np.linalg.norm(vecs, axis=1, keepdims=True)
     d, g = _cast((per_ray_jit,), rg, pnts, vecs, 10.0)
-    ref, ref_id = rc.mj_rays(compiled, pnts, vecs, GROUPS)
+    ref, ref_id = mj_rays(compiled, pnts, vecs, GROUPS)
     for i, (_, _, want) in enumerate(cases):
         if math.isinf(want):
             assert np.isinf(d[i]) and np.isinf(ref[i])
@@ -244,13 +248,13 @@ def test_fast_ray_hand_built(two_room, per_ray_jit):
     d, _ = _cast((per_ray_jit,), rg, pnts, vecs, 0.9)
     assert np.isinf(d[[0, 4]]).all()
     # without the floor, the downward ray misses
-    one = jax.jit(lambda p, v: rc.fast_ray_hit(rg, p, v, 10.0, include_floor=False))
+    one = jax.jit(lambda p, v: fast_ray_hit(rg, p, v, 10.0, include_floor=False))
     assert np.isinf(float(one(jnp.asarray(pnts[4], jnp.float32), jnp.asarray(vecs[4], jnp.float32))[0]))
 
 
 def test_line_of_sight(two_room):
     compiled, grid, rg = two_room
-    los = jax.jit(jax.vmap(lambda a, b: rc.line_of_sight(rg, a, b)))
+    los = jax.jit(jax.vmap(lambda a, b: line_of_sight(rg, a, b)))
     painting_face = np.array([2.5, 3.897 - 0.003, 1.5])  # the canvas's front face
     a = np.array([
         [1.0, 1.0, 1.2],  # across the living room, nothing in between
@@ -278,7 +282,7 @@ def test_line_of_sight(two_room):
     # consistent with mj_ray on the same segments (up to segments ending within 1 mm of a surface)
     d = b - a
     length = np.linalg.norm(d, axis=1)
-    ref, _ = rc.mj_rays(compiled, a, d / length[:, None], GROUPS)
+    ref, _ = mj_rays(compiled, a, d / length[:, None], GROUPS)
     clear = np.abs(ref - (length - 0.05)) > 1e-3
     assert np.array_equal(got[clear], (ref >= length - 0.05)[clear])
     assert 0.2 < got.mean() < 0.9
@@ -287,7 +291,7 @@ def test_line_of_sight(two_room):
 @pytest.mark.slow
 def test_benchmark_rays_smoke(two_room):
     compiled, grid, _ = two_room
-    r = rc.benchmark_rays(compiled, grid, n_rays=640, max_dist=5.0, seed=0, repeat=1)
+    r = benchmark_rays(compiled, grid, n_rays=640, max_dist=5.0, seed=0, repeat=1)
     for key in ("fast_rays_per_s", "mjx_rays_per_s", "exact_rays_per_s", "multiray_rays_per_s"):
         assert r[key] > 0
     assert r["n_rays"] == 640 and r["agreement"] >= 0.99 and r["agreement_exact"] == 1.0

@@ -21,7 +21,8 @@ import math
 import jax
 import jax.numpy as jnp
 
-from ignjax.sim.rays.caster import RayGrid, _prim_hit
+from ignjax.scenes.raygrid import RayGrid
+from ignjax.sim.rays.fast import _prim_hit
 
 _OCCUPIED_MAX_CODE = 1  # voxcode 0: partly occupied, 1: inside a primitive, 2: free but touched, >= 3: free
 

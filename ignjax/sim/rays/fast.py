@@ -1,224 +1,68 @@
-"""Ray casting: the exact path (MuJoCo / MJX) and the fast voxel path.
+"""The fast ray caster: voxel march with exact primitive tests.
 
-Distances are metres along a unit direction; a miss is ``+inf`` on every
-path here (MuJoCo's ``-1`` is converted), and the geom id of a miss is -1.
+Distances are metres along a unit direction; a miss is ``+inf`` and the geom
+id of a miss is -1. The exact reference is :mod:`ignjax.sim.rays.exact`.
 
-Exact path
-    :func:`exact_rays` is ``mjx.ray`` on the compiled model, vmapped over rays
-    and jitted. ``mjx.ray`` (mujoco-mjx 3.17) has no cylinder intersection and
-    silently ignores cylinder geoms, so :func:`exact_rays` intersects the
-    cylinders itself (the same primitive test as the fast path) and keeps the
-    nearer hit; the result matches ``mujoco.mj_ray``. The C references are
-    :func:`mj_rays` (a loop over ``mujoco.mj_ray``, any origins) and
-    :func:`mj_multiray` (``mujoco.mj_multiRay``, one origin). Rays are cast
-    with ``flg_static=1``; ``geomgroup`` selects groups as in MuJoCo (a
-    6-sequence of flags, None = every group).
+:func:`fast_ray` / :func:`fast_ray_hit` (one ray, to be vmapped) and
+:func:`fast_rays` (a batch, same results, much faster) are pure functions
+of a :class:`~ignjax.scenes.raygrid.RayGrid`: arrays with a leading scene
+axis, so one stacked grid serves episodes from different scenes through
+``scene_index`` without copying any grid (pass it unbatched under
+``vmap``). Distances are exact up to float32 for primitive geoms (boxes,
+spheres, ellipsoids, cylinders, capsules); meshes are voxel-accurate. A ray
+works in three parts (voxel index space, see :mod:`ignjax.scenes.voxels`):
 
-Fast path
-    :func:`fast_ray` / :func:`fast_ray_hit` (one ray, to be vmapped) and
-    :func:`fast_rays` (a batch, same results, much faster) are pure functions
-    of a :class:`RayGrid`: arrays with a leading scene axis, so one stacked
-    grid serves episodes from different scenes through ``scene_index``
-    without copying any grid (pass it unbatched under ``vmap``). Distances
-    are exact up to float32 for primitive geoms (boxes, spheres, ellipsoids,
-    cylinders, capsules); meshes are voxel-accurate. A ray works in three
-    parts (voxel index space, see :mod:`ignjax.scenes.navgrid`):
+1. *Empty-space skipping.* A free voxel's code says that the cube of
+   voxels around it within its chessboard distance minus one is free, so
+   the ray jumps to where it leaves that cube (exact: it never skips an
+   occupied voxel). Next to geometry this is a voxel-by-voxel traversal;
+   across an open room it is a handful of jumps. A partly occupied voxel
+   also carries the box (in quarters of a voxel) that its geometry lies
+   in; a ray that misses that box passes the voxel like a free one, which
+   spares most exact tests of rays skimming over a table top.
+2. *Exact refinement.* A voxel entirely inside one primitive ends the ray
+   at its entry point (exact, since the ray enters it from free space).
+   At a partly occupied voxel the primitives listed for its column
+   segment (``list_band_height`` tall) are intersected exactly (a box
+   intersected with a quadric, :func:`prim_hit`; a capsule is three of
+   them, all widened by 10 um so that a ray lying in a face's plane hits
+   it, as in ``mj_ray``). A hit inside the segment is the answer;
+   otherwise the voxel was only touched by a bounding box (a "false
+   positive") and the march resumes after the segment. After ``rounds``
+   false positives a ray stops at the voxel it reached (voxel accuracy,
+   conservative); segments holding a mesh or more than ``max_list``
+   primitives are answered at the voxel too.
+3. *Floor.* The floor plane (z = 0, its finite MuJoCo extent, hit from
+   above only) is intersected analytically when ``include_floor``.
 
-    1. *Empty-space skipping.* A free voxel's code says that the cube of
-       voxels around it within its chessboard distance minus one is free, so
-       the ray jumps to where it leaves that cube (exact: it never skips an
-       occupied voxel). Next to geometry this is a voxel-by-voxel traversal;
-       across an open room it is a handful of jumps. A partly occupied voxel
-       also carries the box (in quarters of a voxel) that its geometry lies
-       in; a ray that misses that box passes the voxel like a free one, which
-       spares most exact tests of rays skimming over a table top.
-    2. *Exact refinement.* A voxel entirely inside one primitive ends the ray
-       at its entry point (exact, since the ray enters it from free space).
-       At a partly occupied voxel the primitives listed for its column
-       segment (``list_band_height`` tall) are intersected exactly (a box
-       intersected with a quadric; a capsule is three of them, all widened
-       by 10 um so that a ray lying in a face's plane hits it, as in
-       ``mj_ray``). A hit inside the segment is the answer; otherwise the
-       voxel was only touched by a bounding box (a "false positive") and the
-       march resumes after the segment. After ``rounds`` false positives a
-       ray stops at the voxel it reached (voxel accuracy, conservative);
-       segments holding a mesh or more than ``max_list`` primitives are
-       answered at the voxel too.
-    3. *Floor.* The floor plane (z = 0, its finite MuJoCo extent, hit from
-       above only) is intersected analytically when ``include_floor``.
+A vmapped ``while_loop`` runs as long as its slowest ray; :func:`fast_rays`
+therefore works in stages and gathers the unfinished rays into dense
+batches between them (see its docstring).
 
-    A vmapped ``while_loop`` runs as long as its slowest ray; :func:`fast_rays`
-    therefore works in stages and gathers the unfinished rays into dense
-    batches between them (see its docstring).
+XLA's CPU fusion recomputes cheap elementwise chains in every consumer
+and drops ``optimization_barrier``; :func:`_keep` materialises shared
+intermediates (it divides by a runtime 1.0, an "expensive" op that XLA
+does not duplicate). Without it the exact tests ran 10x slower.
 
-    XLA's CPU fusion recomputes cheap elementwise chains in every consumer
-    and drops ``optimization_barrier``; :func:`_keep` materialises shared
-    intermediates (it divides by a runtime 1.0, an "expensive" op that XLA
-    does not duplicate). Without it the exact tests ran 10x slower.
-
-Agreement with ``mj_ray`` (tested): a fast distance agrees when both miss
-within ``max_dist``, or both hit within it and ``|d_fast - d_exact| <=
-resolution`` (one grid cell); hits within 1e-3 m of ``max_dist`` on either
-side count as agreeing either way.
+Agreement with ``mj_ray`` (tested; :func:`ignjax.bench.rays.agreement`): a
+fast distance agrees when both miss within ``max_dist``, or both hit within
+it and ``|d_fast - d_exact| <= resolution`` (one grid cell); hits within
+1e-3 m of ``max_dist`` on either side count as agreeing either way.
 """
 
 from __future__ import annotations
 
-import math
-import time
-import weakref
-from dataclasses import dataclass
-from functools import partial
-from typing import NamedTuple, Sequence
+from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
-import mujoco
-import numpy as np
 
-from ignjax.scenes.navgrid import N_PRIM_COLUMNS, SUB_Q, NavGrid, geom_prims
+from ignjax.scenes.raygrid import RayGrid
+from ignjax.scenes.voxels import N_PRIM_COLUMNS, SUB_Q
 
 _EPS = 1e-4  # metres: tolerance of the exact window and of resuming after a segment
 _TINY = 1e-20  # replaces exact zero direction components (slab tests need no special case)
 _TOUCH = 1e-5  # metres: the fast path's primitives are this much wider, so a ray exactly in a face's plane hits it
-
-
-# ---------------------------------------------------------------------------
-# The fast-path grid
-# ---------------------------------------------------------------------------
-
-
-@partial(jax.tree_util.register_dataclass,
-         data_fields=["voxcode", "sub_box", "seg_start", "seg_count", "seg_prims", "approx", "prims", "prim_geom",
-                      "origin", "dims", "floor"],
-         meta_fields=["resolution", "slice_height", "slices_per_band", "max_count"])
-@dataclass(frozen=True)
-class RayGrid:
-    """Arrays of the fast ray caster for S scenes, padded to shared maxima.
-
-    Attributes:
-        voxcode: (S, Z, H, W) uint8 voxel march codes (:func:`navgrid.march_codes`).
-        sub_box: (S, Z, H, W) uint16 where the geometry of each occupied voxel
-            lies (:func:`navgrid.pack_sub_boxes`).
-        seg_start: (S, H, W, B) int32 first entry of each column segment in ``seg_prims``.
-        seg_count: (S, H, W, B) uint8 primitives in each segment.
-        seg_prims: (S, M) int32 primitive indices, segment after segment.
-        approx: (S, H, W, B) bool, segment answered at voxel accuracy.
-        prims: (S, 18, P) float32 primitives, one row of
-            :data:`navgrid.PRIM_COLUMNS` per column (structure of arrays).
-        prim_geom: (S, P) int32 MuJoCo geom id of each primitive.
-        origin: (S, 2) float32 world (x, y) of the grid's corner.
-        dims: (S, 3) int32 valid extent (W, H, Z) of each scene's grid.
-        floor: (S, 5) float32 floor plane rectangle (cx, cy, hx, hy) and its
-            geom id (as a float); hx < 0 for no floor.
-        resolution: cell size, metres (static).
-        slice_height: voxel height, metres (static).
-        slices_per_band: voxel slices per list segment (static).
-        max_count: largest ``seg_count`` (static): exact tests per segment.
-    """
-
-    voxcode: jax.Array
-    sub_box: jax.Array
-    seg_start: jax.Array
-    seg_count: jax.Array
-    seg_prims: jax.Array
-    approx: jax.Array
-    prims: jax.Array
-    prim_geom: jax.Array
-    origin: jax.Array
-    dims: jax.Array
-    floor: jax.Array
-    resolution: float = 0.05
-    slice_height: float = 0.05
-    slices_per_band: int = 5
-    max_count: int = 1
-
-    @property
-    def n_scenes(self) -> int:
-        return int(self.voxcode.shape[0])
-
-
-def _floor_row(compiled) -> np.ndarray:
-    """(5,) floor rectangle (cx, cy, hx, hy, geom id) of a compiled scene."""
-    m, d = compiled.model, compiled.data
-    for g in range(m.ngeom):
-        if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_PLANE:
-            R = d.geom_xmat[g].reshape(3, 3)
-            if abs(R[2, 2] - 1.0) < 1e-9 and abs(d.geom_xpos[g][2]) < 1e-9:
-                sx, sy = float(m.geom_size[g][0]), float(m.geom_size[g][1])
-                big = 1e9
-                return np.array([d.geom_xpos[g][0], d.geom_xpos[g][1], sx if sx > 0 else big, sy if sy > 0 else big, g],
-                                np.float32)
-    return np.array([0, 0, -1, -1, -1], np.float32)
-
-
-def ray_grid_arrays(grid: NavGrid, compiled=None) -> dict[str, np.ndarray]:
-    """Per-scene host arrays of a :class:`RayGrid` (no scene axis).
-
-    Args:
-        grid: the scene's navigation grid.
-        compiled: its compiled scene, for the floor plane (None: no floor).
-    """
-    prims = grid.prims if len(grid.prims) else np.full((1, N_PRIM_COLUMNS), -1.0, np.float32)
-    return {
-        "voxcode": grid.voxcode,
-        "sub_box": grid.sub_box,
-        "seg_start": grid.seg_start,
-        "seg_count": grid.seg_count,
-        "seg_prims": grid.seg_prims if len(grid.seg_prims) else np.full((1,), -1, np.int32),
-        "approx": grid.approx,
-        "prims": np.ascontiguousarray(prims.T),
-        "prim_geom": grid.prim_geom if len(grid.prim_geom) else np.full((1,), -1, np.int32),
-        "origin": np.asarray(grid.origin, np.float32),
-        "dims": np.array([grid.shape[1], grid.shape[0], grid.n_slices], np.int32),
-        "floor": _floor_row(compiled) if compiled is not None else np.array([0, 0, -1, -1, -1], np.float32),
-    }
-
-
-_PAD_VALUES = {"voxcode": 255, "sub_box": 0, "seg_start": 0, "seg_count": 0, "seg_prims": -1, "approx": False,
-               "prims": -1.0, "prim_geom": -1, "origin": 0.0, "dims": 0, "floor": -1.0}
-
-
-def stack_ray_arrays(arrays: Sequence[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
-    """Pad per-scene ray arrays to shared maxima and stack them (scene axis 0).
-
-    Padding is free space (voxel code 255, empty segments, primitives that are
-    never hit); rays never reach it because each scene's march is clipped to
-    its own ``dims``.
-    """
-    out = {}
-    for name in _PAD_VALUES:
-        items = [a[name] for a in arrays]
-        shape = tuple(max(s) for s in zip(*[x.shape for x in items]))
-        stacked = np.full((len(items),) + shape, _PAD_VALUES[name], dtype=items[0].dtype)
-        for i, x in enumerate(items):
-            stacked[(i,) + tuple(slice(0, n) for n in x.shape)] = x
-        out[name] = stacked
-    return out
-
-
-def ray_grid(grids: NavGrid | Sequence[NavGrid], compiled=None) -> RayGrid:
-    """A device :class:`RayGrid` of one or several scenes.
-
-    Args:
-        grids: one :class:`NavGrid` or a sequence of them (same resolution,
-            slice height and list band height).
-        compiled: the matching compiled scene(s), for the floor planes.
-    """
-    if isinstance(grids, NavGrid):
-        grids = [grids]
-        compiled = [compiled]
-    grids = list(grids)
-    compiled = list(compiled) if compiled is not None else [None] * len(grids)
-    cfg = grids[0].config
-    for g in grids[1:]:
-        if (g.config.resolution, g.config.slice_height, g.config.list_band_height) != \
-                (cfg.resolution, cfg.slice_height, cfg.list_band_height):
-            raise ValueError("all grids of a RayGrid need the same resolution, slice_height and list_band_height")
-    arrs = stack_ray_arrays([ray_grid_arrays(g, c) for g, c in zip(grids, compiled)])
-    return RayGrid(**{k: jnp.asarray(v) for k, v in arrs.items()}, resolution=cfg.resolution,
-                   slice_height=cfg.slice_height, slices_per_band=cfg.slices_per_list_band,
-                   max_count=max(int(arrs["seg_count"].max(initial=0)), 1))
 
 
 # ---------------------------------------------------------------------------
@@ -276,7 +120,7 @@ def prim_hit(row: jax.Array, pnt: jax.Array, vec: jax.Array) -> jax.Array:
     starts inside; +inf on a miss.
 
     Args:
-        row: (18,) primitive, :data:`ignjax.scenes.navgrid.PRIM_COLUMNS`.
+        row: (18,) primitive, :data:`ignjax.scenes.voxels.PRIM_COLUMNS`.
         pnt: (3,) ray origin.
         vec: (3,) ray direction.
 
@@ -745,279 +589,3 @@ def line_of_sight(grid: RayGrid, a: jax.Array, b: jax.Array, scene_index: jax.Ar
     reach = jnp.maximum(length - ignore_end, 0.0)
     dist = fast_ray(grid, a, vec, reach, scene_index)
     return (dist > reach) | (reach <= 0)
-
-
-# ---------------------------------------------------------------------------
-# Exact path
-# ---------------------------------------------------------------------------
-
-
-def _group_mask(geomgroup) -> np.ndarray | None:
-    if geomgroup is None:
-        return None
-    g = np.zeros(mujoco.mjNGROUP, np.uint8)
-    vals = np.asarray(geomgroup).astype(np.uint8).ravel()
-    g[:len(vals)] = vals[:mujoco.mjNGROUP]
-    return g
-
-
-def _cylinder_rows(compiled, geomgroup) -> tuple[np.ndarray, np.ndarray]:
-    m, d = compiled.model, compiled.data
-    mask = _group_mask(geomgroup)
-    rows, ids = [], []
-    for g in range(m.ngeom):
-        if m.geom_type[g] != mujoco.mjtGeom.mjGEOM_CYLINDER:
-            continue
-        if mask is not None and not mask[min(int(m.geom_group[g]), mujoco.mjNGROUP - 1)]:
-            continue
-        mat = int(m.geom_matid[g])
-        alpha = m.mat_rgba[mat, 3] if mat >= 0 else m.geom_rgba[g, 3]
-        if alpha == 0:
-            continue
-        rows += geom_prims(m, d, g)
-        ids.append(g)
-    if not rows:
-        return np.zeros((0, N_PRIM_COLUMNS), np.float32), np.zeros((0,), np.int32)
-    return np.stack(rows).astype(np.float32), np.asarray(ids, np.int32)
-
-
-def exact_ray(mjx_model, mjx_data, cylinders: jax.Array, cylinder_ids: jax.Array, pnt: jax.Array,
-              vec: jax.Array, geomgroup: tuple[int, ...] = ()) -> tuple[jax.Array, jax.Array]:
-    """``mjx.ray`` plus the cylinders it ignores, for one ray.
-
-    Args:
-        mjx_model, mjx_data: the MJX model and data.
-        cylinders: (C, 18) cylinder primitives (:func:`navgrid.geom_prims`).
-        cylinder_ids: (C,) their geom ids.
-        pnt: (3,) origin.
-        vec: (3,) direction.
-        geomgroup: MuJoCo group flags (static), () for all.
-
-    Returns:
-        (dist () float32, +inf on a miss; geomid () int32, -1 on a miss).
-    """
-    from mujoco import mjx
-
-    d, g = mjx.ray(mjx_model, mjx_data, pnt, vec, geomgroup=geomgroup)
-    d = jnp.where(d < 0, jnp.inf, d)
-    if cylinders.shape[0]:
-        tc = jax.vmap(prim_hit, in_axes=(0, None, None))(cylinders, pnt, vec)
-        k = jnp.argmin(tc)
-        take = tc[k] < d
-        d = jnp.where(take, tc[k], d)
-        g = jnp.where(take, cylinder_ids[k], g)
-    return d, g
-
-
-_EXACT_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-
-
-def exact_rays(compiled, pnts, vecs, geomgroup=None) -> tuple[jax.Array, jax.Array]:
-    """Exact distances of many rays with ``mjx.ray`` (jitted, vmapped).
-
-    Args:
-        compiled: a :class:`~ignjax.scenes.compile.CompiledScene`.
-        pnts: (N, 3) origins.
-        vecs: (N, 3) unit directions.
-        geomgroup: MuJoCo group flags (6 values) or None for every group.
-
-    Returns:
-        dist: (N,) float32, +inf on a miss; geomid: (N,) int32, -1 on a miss.
-    """
-    key = None if geomgroup is None else tuple(int(bool(x)) for x in _group_mask(geomgroup))
-    per = _EXACT_CACHE.setdefault(compiled, {})
-    if key not in per:
-        cyl, cid = _cylinder_rows(compiled, geomgroup)
-        mx, dx = compiled.mjx_model, compiled.mjx_data
-        cyl_j, cid_j = jnp.asarray(cyl), jnp.asarray(cid)
-        gg = key or ()
-        per[key] = jax.jit(jax.vmap(lambda p, v: exact_ray(mx, dx, cyl_j, cid_j, p, v, gg)))
-    return per[key](jnp.asarray(pnts, jnp.float32), jnp.asarray(vecs, jnp.float32))
-
-
-def mj_rays(compiled, pnts, vecs, geomgroup=None) -> tuple[np.ndarray, np.ndarray]:
-    """C reference: ``mujoco.mj_ray`` for each ray (``flg_static=1``).
-
-    Returns:
-        dist: (N,) float64, +inf on a miss; geomid: (N,) int32, -1 on a miss.
-    """
-    m, d = compiled.model, compiled.data
-    mask = _group_mask(geomgroup)
-    pnts = np.asarray(pnts, np.float64).reshape(-1, 3)
-    vecs = np.asarray(vecs, np.float64).reshape(-1, 3)
-    out = np.empty(len(pnts))
-    ids = np.empty(len(pnts), np.int32)
-    gid = np.zeros(1, np.int32)
-    for i in range(len(pnts)):
-        out[i] = mujoco.mj_ray(m, d, pnts[i], vecs[i], mask, 1, -1, gid)
-        ids[i] = gid[0]
-    return np.where(out < 0, np.inf, out), ids
-
-
-def mj_multiray(compiled, pnt, vecs, geomgroup=None, cutoff: float = math.inf) -> tuple[np.ndarray, np.ndarray]:
-    """C reference for rays from one point: ``mujoco.mj_multiRay``.
-
-    Args:
-        compiled: compiled scene.
-        pnt: (3,) common origin.
-        vecs: (N, 3) unit directions.
-        geomgroup: group flags or None.
-        cutoff: MuJoCo's ``cutoff``: geoms whose bounding sphere lies farther
-            are skipped (a speed-up; hits beyond it can still be returned).
-
-    Returns:
-        dist: (N,) float64, +inf on a miss; geomid: (N,) int32, -1 on a miss.
-    """
-    m, d = compiled.model, compiled.data
-    vecs = np.ascontiguousarray(np.asarray(vecs, np.float64).reshape(-1, 3))
-    n = len(vecs)
-    dist = np.empty(n)
-    gid = np.empty(n, np.int32)
-    cut = float(cutoff) if math.isfinite(cutoff) else mujoco.mjMAXVAL
-    mujoco.mj_multiRay(m, d, np.asarray(pnt, np.float64), vecs.ravel(), _group_mask(geomgroup), 1, -1, gid, dist,
-                       None, n, cut)
-    return np.where(dist < 0, np.inf, dist), gid
-
-
-def ray_groups_mask(groups: Sequence[int], include_floor: bool = True) -> tuple[int, ...]:
-    """MuJoCo geomgroup flags selecting ``groups`` (and the floor, group 0)."""
-    g = [0] * mujoco.mjNGROUP
-    for k in groups:
-        g[k] = 1
-    if include_floor:
-        g[0] = 1
-    return tuple(g)
-
-
-# ---------------------------------------------------------------------------
-# Random rays, agreement and benchmark
-# ---------------------------------------------------------------------------
-
-
-def random_rays(grid: NavGrid, n_origins: int, per_origin: int, rng: np.random.Generator,
-                heights=(0.1, 2.0), pitch_deg: float = 45.0, horizontal: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """Random rays from random navigable points.
-
-    Origins are uniform over navigable cells (jittered within the cell) at
-    heights uniform in ``heights``; each origin gets ``per_origin`` rays with
-    uniform yaw and pitch uniform in ``[-pitch_deg, pitch_deg]`` (0 when
-    ``horizontal``). Rays are grouped by origin (ray ``i`` starts at origin
-    ``i // per_origin``), so :func:`mj_multiray` can cast them too.
-
-    Returns:
-        pnts: (n_origins * per_origin, 3); vecs: (n_origins * per_origin, 3) unit.
-    """
-    cells = np.argwhere(grid.navigable)
-    if len(cells) == 0:
-        raise ValueError(f"scene {grid.scene_id!r} has no navigable cells")
-    pick = cells[rng.integers(0, len(cells), n_origins)]
-    xy = grid.cell_to_world(pick) + rng.uniform(-0.5, 0.5, (n_origins, 2)) * grid.resolution
-    z = rng.uniform(heights[0], heights[1], n_origins)
-    o = np.concatenate([xy, z[:, None]], 1)
-    n = n_origins * per_origin
-    yaw = rng.uniform(-math.pi, math.pi, n)
-    pitch = np.zeros(n) if horizontal else np.radians(rng.uniform(-pitch_deg, pitch_deg, n))
-    vecs = np.stack([np.cos(yaw) * np.cos(pitch), np.sin(yaw) * np.cos(pitch), np.sin(pitch)], 1)
-    return np.repeat(o, per_origin, axis=0), vecs
-
-
-def agreement(d_fast, d_exact, max_dist: float, tol: float) -> np.ndarray:
-    """Per-ray agreement of two distance arrays (see the module docstring).
-
-    Args:
-        d_fast, d_exact: (N,) distances, +inf (or anything > max_dist) on a miss.
-        max_dist: the rays' range.
-        tol: allowed distance difference for hits (one cell).
-
-    Returns:
-        (N,) bool.
-    """
-    f = np.asarray(d_fast, np.float64)
-    e = np.asarray(d_exact, np.float64)
-    hf, he = f <= max_dist, e <= max_dist
-    both = hf & he & (np.abs(np.where(hf, f, 0) - np.where(he, e, 0)) <= tol)
-    neither = ~hf & ~he
-    edge = (np.abs(np.minimum(f, 1e9) - max_dist) <= 1e-3) | (np.abs(np.minimum(e, 1e9) - max_dist) <= 1e-3)
-    return both | neither | (edge & (hf != he))
-
-
-def _time_interleaved(fns: Sequence, repeat: int = 3) -> list[float]:
-    """Best-of-``repeat`` seconds of each function after a warm-up, the
-    functions taking turns in every round, so that a machine whose speed
-    drifts (a shared VM) slows each of them alike and their ratios hold."""
-    for fn in fns:
-        fn()
-    best = [math.inf] * len(fns)
-    for _ in range(repeat):
-        for i, fn in enumerate(fns):
-            t0 = time.perf_counter()
-            fn()
-            best[i] = min(best[i], time.perf_counter() - t0)
-    return best
-
-
-def benchmark_rays(compiled, grid: NavGrid, n_rays: int = 100_000, max_dist: float = 5.0, seed: int = 0,
-                   horizontal: bool = False, heights=(0.1, 2.0), per_origin: int = 32,
-                   include_floor: bool = True, repeat: int = 3) -> dict:
-    """Throughput and agreement of the fast path against ``mjx.ray`` and
-    ``mj_multiRay`` on the same random rays, in one process.
-
-    Rays: :func:`random_rays` (``horizontal=True`` for collision rays), in
-    groups of ``per_origin`` rays sharing an origin so that ``mj_multiRay``
-    casts exactly the same rays (one call per origin, ``cutoff=max_dist``).
-    Timed: the batched fast path (:func:`fast_rays`, jitted), raw
-    ``mjx.ray`` (vmapped, jitted; it ignores cylinders), the exact path
-    (:func:`exact_rays`: ``mjx.ray`` plus cylinders) and ``mj_multiRay``.
-    Times are the best of ``repeat`` runs after a warm-up (compilation
-    excluded), the four paths taking turns in every round. Agreement is measured against ``mj_multiRay`` with
-    :func:`agreement` at a tolerance of one grid cell.
-
-    Returns:
-        dict: ``n_rays``, ``max_dist``, ``horizontal``, ``ngeom``,
-        ``fast_rays_per_s``, ``mjx_rays_per_s``, ``exact_rays_per_s``,
-        ``multiray_rays_per_s``, ``speedup_vs_mjx``, ``speedup_vs_multiray``,
-        ``agreement`` (fast vs mj_multiRay), ``agreement_exact`` (exact path
-        vs mj_multiRay, 1 mm) and ``hit_fraction``.
-    """
-    from mujoco import mjx
-
-    rng = np.random.default_rng(seed)
-    n_orig = max(n_rays // per_origin, 1)
-    pnts, vecs = random_rays(grid, n_orig, per_origin, rng, heights=heights, horizontal=horizontal)
-    n = len(pnts)
-    rg = ray_grid(grid, compiled)
-    groups = ray_groups_mask(grid.config.ray_groups, include_floor)
-    P = jnp.asarray(pnts, jnp.float32)
-    V = jnp.asarray(vecs, jnp.float32)
-    fast = jax.jit(lambda p, v: fast_rays(rg, p, v, max_dist, 0, include_floor)[0])
-    mx, dx = compiled.mjx_model, compiled.mjx_data
-    raw = jax.jit(jax.vmap(lambda p, v: mjx.ray(mx, dx, p, v, geomgroup=groups)[0]))
-    out = {}
-
-    def run_fast():
-        out["fast"] = jax.block_until_ready(fast(P, V))
-
-    def run_raw():
-        out["raw"] = jax.block_until_ready(raw(P, V))
-
-    def run_exact():
-        out["exact"] = jax.block_until_ready(exact_rays(compiled, P, V, groups)[0])
-
-    def run_multi():
-        res = []
-        for i in range(n_orig):
-            sl = slice(i * per_origin, (i + 1) * per_origin)
-            res.append(mj_multiray(compiled, pnts[i * per_origin], vecs[sl], groups, cutoff=max_dist)[0])
-        out["multi"] = np.concatenate(res)
-
-    t_fast, t_raw, t_exact, t_multi = _time_interleaved((run_fast, run_raw, run_exact, run_multi), repeat)
-    ref = out["multi"]
-    agree = agreement(np.asarray(out["fast"]), ref, max_dist, grid.resolution)
-    agree_exact = agreement(np.asarray(out["exact"]), ref, max_dist, 1e-3)
-    return {
-        "n_rays": int(n), "max_dist": float(max_dist), "horizontal": bool(horizontal), "ngeom": int(compiled.ngeom),
-        "fast_rays_per_s": n / t_fast, "mjx_rays_per_s": n / t_raw, "exact_rays_per_s": n / t_exact,
-        "multiray_rays_per_s": n / t_multi, "speedup_vs_mjx": t_raw / t_fast, "speedup_vs_multiray": t_multi / t_fast,
-        "agreement": float(agree.mean()), "agreement_exact": float(agree_exact.mean()),
-        "hit_fraction": float((ref <= max_dist).mean()),
-    }
