@@ -5,7 +5,7 @@ Sub-packages follow the data flow: ``scenes`` (scene model, importers,
 procedural houses, compilation to MuJoCo/MJX, navigation grids), ``episodes``
 (benchmark construction), ``sim`` (batched simulator and oracle), ``agents``,
 ``studies``; command lines are ``python -m ignjax.build``,
-``ignjax.evaluate.cli``, ``ignjax.sweep.runner`` and ``ignjax.bench.runner``.
+``ignjax.evaluate.cli``, ``ignjax.sweep.cli`` and ``ignjax.bench.runner``.
 """
 
 import os as _os

@@ -24,6 +24,7 @@ from ignjax.errors import ConfigError, IgnjaxError, SceneError
 
 
 def _progress(iterable, total: int, desc: str, quiet: bool):
+    # imported on use, so that --help and the other commands answer at once
     from tqdm.auto import tqdm
 
     return tqdm(iterable, total=total, desc=desc, disable=quiet, file=sys.stderr, dynamic_ncols=True)
@@ -31,6 +32,7 @@ def _progress(iterable, total: int, desc: str, quiet: bool):
 
 def cmd_scenes(args) -> int:
     """Generate procedural houses, write them as USD plus a manifest."""
+    # imported on use, so that --help and the other commands answer at once
     from ignjax.scenes.procgen import generate as procgen
     from ignjax.scenes.io.manifest import manifest_entry, write_manifest
     from ignjax.scenes.io.usd import save_usd
@@ -45,6 +47,7 @@ def cmd_scenes(args) -> int:
     entries = []
     for scene in _progress(scenes, len(scenes), "houses", args.quiet):
         if args.check:
+            # imported on use, so that --help and the other commands answer at once
             from ignjax.scenes.compile import compile_scene
             from ignjax.scenes.navgrid import GridConfig, build_navgrid, check_reachable
 
@@ -53,6 +56,7 @@ def cmd_scenes(args) -> int:
         path = save_usd(scene, out / f"{scene.id}.usda")
         entries.append(manifest_entry(scene, path))
         if args.maps:
+            # imported on use, so that --help and the other commands answer at once
             from ignjax.scenes.viz.mapplot import plot_scene_map
 
             (out / "maps").mkdir(exist_ok=True)
@@ -66,6 +70,7 @@ def cmd_scenes(args) -> int:
 
 def cmd_inspect(args) -> int:
     """Summarise any supported scene source."""
+    # imported on use, so that --help and the other commands answer at once
     from ignjax.scenes.io.sources import load_scenes
     from ignjax.scenes.model import scene_summary
 
@@ -92,10 +97,13 @@ def cmd_inspect(args) -> int:
 
 def cmd_render(args) -> int:
     """Top-down map and first-person 8-view panorama of a scene."""
+    # imported on use, so that --help and the other commands answer at once
     import math
 
+    # imported on use, so that --help and the other commands answer at once
     import numpy as np
 
+    # imported on use, so that --help and the other commands answer at once
     from ignjax.scenes.compile import compile_scene
     from ignjax.scenes.io.sources import load_scenes
     from ignjax.scenes.viz.mapplot import plot_scene_map
@@ -136,6 +144,7 @@ def cmd_render(args) -> int:
 
 
 def cmd_episodes(args) -> int:
+    # imported on use, so that --help and the other commands answer at once
     from ignjax.build.episodes import run_episodes_command
 
     return run_episodes_command(args)

@@ -35,6 +35,7 @@ from ignjax.scenes.io.sources import scene_sources
 
 
 def _out_paths(out: Path) -> dict[str, Path]:
+    # imported on use, so that --help and the other commands answer at once
     from ignjax.episodes.schema import construction_path
 
     name = out.name
@@ -49,8 +50,10 @@ def _out_paths(out: Path) -> dict[str, Path]:
 
 
 def build_episodes(args) -> int:
+    # imported on use, so that --help and the other commands answer at once
     from tqdm.auto import tqdm
 
+    # imported on use, so that --help and the other commands answer at once
     from ignjax.episodes.construct import BuildConfig, build_benchmark
     from ignjax.episodes.difficulty import validate_alpha, validate_thresholds
     from ignjax.episodes.schema import strip_record, write_records
@@ -105,12 +108,14 @@ def build_episodes(args) -> int:
 
 
 def check_episodes(args) -> int:
+    # imported on use, so that --help and the other commands answer at once
     from ignjax.episodes.schema import read_episodes
     from ignjax.episodes.stats import format_summary, summarize
 
     path = Path(args.check)
     records = read_episodes(path)
     if not args.schema_only:
+        # imported on use, so that --help and the other commands answer at once
         from ignjax.episodes.dataset import load_benchmark
 
         es = load_benchmark(path)

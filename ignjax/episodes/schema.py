@@ -35,14 +35,15 @@ Released record (version 1)::
 from __future__ import annotations
 
 import gzip
+import io
 import json
 import math
 import os
 from pathlib import Path
 from typing import Any, Iterable, Iterator
 
-from ignjax.episodes.difficulty import BIN_NAMES, FACTOR_NAMES
 from ignjax.errors import EpisodeError
+from ignjax.protocol import BIN_NAMES, FACTOR_NAMES
 
 SCHEMA = "ignjax-episode"
 CONSTRUCTION_SCHEMA = "ignjax-episode-construction"
@@ -157,8 +158,6 @@ def _open(path: Path, mode: str, gz: bool | None = None):
         # mtime=0 and no file name in the header: the same records give the same bytes
         raw = open(path, mode.replace("t", "") + "b")
         gz = gzip.GzipFile(filename="", mode=mode.replace("t", "") + "b", fileobj=raw, mtime=0)
-        import io
-
         return io.TextIOWrapper(gz, encoding="utf-8", newline="\n") if "t" in mode else gz
     return open(path, mode, encoding="utf-8", newline="\n")
 

@@ -14,8 +14,11 @@ import os
 from collections import Counter
 
 import numpy as np
+from matplotlib.figure import Figure
 
-from ignjax.episodes.difficulty import BIN_NAMES, FactorNorms
+from ignjax.episodes.difficulty import FactorNorms
+from ignjax.protocol import BIN_NAMES
+from ignjax.scenes.viz.mapplot import save_figure
 
 
 def _start_distance(rec: dict, cons: dict | None, norms: FactorNorms) -> float:
@@ -73,8 +76,6 @@ def format_summary(name: str, s: dict, top: int = 10) -> str:
 def statistics_figure(corpus: dict, subset: dict | None, path: str | os.PathLike, title: str = "Benchmark statistics",
                       thresholds=(0.30, 0.60)):
     """Draw six panels (corpus in grey, subset in colour) and write a PNG atomically."""
-    from matplotlib.figure import Figure
-
     fig = Figure(figsize=(15, 8.5), dpi=110)
     axes = fig.subplots(2, 3)
     sets = [("corpus", corpus, "#9e9e9e")] + ([("subset", subset, "#1f77b4")] if subset else [])
@@ -138,7 +139,5 @@ def statistics_figure(corpus: dict, subset: dict | None, path: str | os.PathLike
 
     fig.suptitle(title)
     fig.tight_layout()
-    from ignjax.scenes.viz.mapplot import save_figure
-
     save_figure(fig, path, 110)
     return fig

@@ -25,6 +25,7 @@ from ignjax.protocol import LOCKED_COSTS, SUCCESS_THRESHOLDS
 
 
 def build_parser() -> argparse.ArgumentParser:
+    # imported on use, so that --help and the other commands answer at once
     from ignjax.agents import registry
 
     agents = registry()
@@ -60,8 +61,10 @@ def main(argv=None) -> int:
 
 
 def run(args) -> int:
+    # imported on use, so that --help and the other commands answer at once
     from tqdm.auto import tqdm
 
+    # imported on use, so that --help and the other commands answer at once
     from ignjax.evaluate import metrics as M
     from ignjax.agents import get_agent
     from ignjax.episodes.dataset import load_benchmark

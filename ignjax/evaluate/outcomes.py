@@ -35,11 +35,13 @@ import os
 from pathlib import Path
 
 import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
 
-from ignjax.evaluate import metrics as M
-from ignjax.protocol import BIN_INDEX, BIN_NAMES, LOCKED_COSTS, SUCCESS_THRESHOLDS
 from ignjax.errors import InputError
+from ignjax.evaluate import metrics as M
 from ignjax.fileio import atomic_write
+from ignjax.protocol import BIN_INDEX, BIN_NAMES, LOCKED_COSTS, SUCCESS_THRESHOLDS
 from ignjax.sim.types import STOP_REASONS, OutcomeRow
 
 COLUMNS: tuple[str, ...] = (
@@ -87,8 +89,6 @@ def outcome_rows(agent: str, records: list[dict], out) -> list[dict]:
 
 
 def _arrow_table(rows: list[dict]):
-    import pyarrow as pa
-
     schema = pa.schema([("agent", pa.string()), ("episode_id", pa.string()), ("scene_id", pa.string()),
                         ("difficulty", pa.string()), ("final_distance", pa.float64()), ("final_euclidean", pa.float64()),
                         ("min_distance", pa.float64()), ("path_length", pa.float64()), ("steps", pa.int32()),
@@ -100,8 +100,6 @@ def _arrow_table(rows: list[dict]):
 
 def write_outcomes(rows: list[dict], folder: str | os.PathLike, name: str = "outcomes") -> tuple[Path, Path]:
     """Write ``name.parquet`` and ``name.csv`` atomically. Returns both paths."""
-    import pyarrow.parquet as pq
-
     folder = Path(folder)
     table = _arrow_table(rows)
     buf = io.BytesIO()
@@ -128,8 +126,6 @@ def read_outcomes(path: str | os.PathLike) -> list[dict]:
     if not p.exists():
         raise InputError(p, None, "no such file")
     if p.suffix == ".parquet":
-        import pyarrow.parquet as pq
-
         rows = pq.read_table(p).to_pylist()
     elif p.suffix == ".csv":
         with open(p, newline="") as f:

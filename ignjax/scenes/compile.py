@@ -122,14 +122,14 @@ class CompiledScene:
     @cached_property
     def mjx_model(self):
         """The ``mjx.Model`` (JAX implementation) of this scene."""
-        from mujoco import mjx
+        from mujoco import mjx  # on use: importing mujoco.mjx takes about 3 s
 
         return mjx.put_model(self.model, impl="jax")
 
     @cached_property
     def mjx_data(self):
         """``mjx.Data`` with the static geom poses of ``data``."""
-        from mujoco import mjx
+        from mujoco import mjx  # on use: importing mujoco.mjx takes about 3 s
 
         return mjx.put_data(self.model, self.data, impl="jax")
 

@@ -87,6 +87,7 @@ import numpy as np
 from scipy import ndimage
 
 from ignjax.errors import ConfigError, InputError
+from ignjax.evaluate.outcomes import parse_trace
 from ignjax.protocol import BIN_NAMES, TYPE_LABELS
 from ignjax.studies._common import as_array, new_figure, save
 
@@ -123,8 +124,6 @@ def events_from_rows(rows: list[dict], *, agent: str | None = None, include_refu
         dict with ``episode``, ``type``, ``step`` (N,) int64, ``charged`` (N,)
         bool, ``steps_used`` (E,), ``difficulty`` (E,) int64, ``episode_id`` (E,).
     """
-    from ignjax.evaluate.outcomes import parse_trace
-
     agents = sorted({str(r.get("agent", "")) for r in rows})
     if agent is None and len(agents) > 1:
         raise InputError(None, "agent", f"the rows hold several agents {agents}; name the one to analyse")

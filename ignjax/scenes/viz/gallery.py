@@ -27,10 +27,14 @@ import sys
 from typing import Iterable, Sequence
 
 import numpy as np
+from PIL import Image, ImageDraw, ImageFont
+from tqdm import tqdm
 
+from ignjax.scenes.compile import compile_scene
 from ignjax.scenes.model import Attributes, Room, Scene, SceneMeta, Wall
 from ignjax.scenes.procgen import catalogue as cat
 from ignjax.scenes.viz import headless_gl
+from ignjax.scenes.viz.render import render_rgb
 
 FOVY = 40.0
 """Vertical field of view of the gallery camera, degrees."""
@@ -100,9 +104,6 @@ def camera_for(built: cat.Built, z0: float, fovy: float = FOVY) -> tuple[np.ndar
 
 def render_tile(category: str, attrs: Attributes, size: int = 160, seed: int = 0) -> np.ndarray:
     """RGB image (size, size, 3) uint8 of one object."""
-    from ignjax.scenes.compile import compile_scene
-    from ignjax.scenes.viz.render import render_rgb
-
     scene, built, z0 = object_scene(category, attrs, seed)
     compiled = compile_scene(scene)
     eye, target = camera_for(built, z0)
@@ -110,8 +111,6 @@ def render_tile(category: str, attrs: Attributes, size: int = 160, seed: int = 0
 
 
 def _caption_font(size: int):
-    from PIL import ImageFont
-
     px = max(9, size // 13)
     try:
         return ImageFont.load_default(size=px)
@@ -121,8 +120,6 @@ def _caption_font(size: int):
 
 def compose(tiles: Sequence[tuple[str, np.ndarray]], size: int, cols: int | None = None):
     """Arrange captioned tiles in a grid; returns a ``PIL.Image``."""
-    from PIL import Image, ImageDraw
-
     n = len(tiles)
     cols = cols or max(1, min(n, int(math.ceil(math.sqrt(n * 1.6)))))
     rows = int(math.ceil(n / cols))
@@ -156,8 +153,6 @@ def render_gallery(out, size: int = 160, names: Iterable[str] | None = None, col
     tiles = []
     it = items
     if progress:
-        from tqdm import tqdm
-
         it = tqdm(items, desc="rendering catalogue", unit="tile")
     for caption, name, attrs in it:
         img = render_tile(name, attrs, size, seed)

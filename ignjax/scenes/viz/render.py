@@ -19,6 +19,7 @@ import math
 import os
 import sys
 
+import matplotlib.image as mpimg
 import mujoco
 import numpy as np
 
@@ -126,8 +127,6 @@ def render_rgb(model, data, eye, target, *, fovy: float = 60.0, width: int = 320
 
 def save_png(image: np.ndarray, path) -> None:
     """Write an (H, W, 3) uint8 image as PNG atomically (temp name, then rename)."""
-    import matplotlib.image as mpimg
-
     path = os.fspath(path)
     tmp = f"{path}.tmp-{os.getpid()}.png"
     mpimg.imsave(tmp, np.asarray(image))
