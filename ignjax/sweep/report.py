@@ -12,7 +12,7 @@ import csv
 import io
 import math
 from pathlib import Path
-from types import SimpleNamespace
+from types import MappingProxyType, SimpleNamespace
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -21,7 +21,7 @@ from ignjax.config import SweepConfig
 from ignjax.evaluate import metrics as M
 from ignjax.evaluate.outcomes import metric_rows, outcome_rows, write_metric_table, write_outcomes
 from ignjax.fileio import atomic_write
-from ignjax.protocol import BIN_INDEX, BIN_NAMES, FACTOR_NAMES
+from ignjax.protocol import BIN_INDEX, BIN_NAMES, FACTOR_NAMES, SUCCESS_THRESHOLDS
 from ignjax.scenes.viz.mapplot import plot_scene_map, save_figure
 from ignjax.studies import cost_derivation as C
 from ignjax.studies import cost_sensitivity as CS
@@ -305,6 +305,104 @@ def plot_trajectories(es, tree: dict, n: int, folder: Path, agent: str) -> list[
 # ---------------------------------------------------------------------------
 
 
+def _section_eval(results: dict, es, rollouts: dict, cfg, out: Path) -> list[str]:
+    ev = study_eval(es, rollouts, cfg, out)
+    results["eval"] = ev
+    parts = ["## Evaluation (Table-1 columns)", "",
+             "SR/OSR and WSR in %, NE and TL in metres, Q_t questions per episode; the Easy/Medium/Hard columns "
+             "repeat SR@1.5, WSR@1.5 and |Q| per difficulty. `shortest_path` is privileged (an upper bound).", ""]
+    if all(t in cfg.eval.thresholds for t in SUCCESS_THRESHOLDS):
+        parts += [M.table1(ev["metrics"], "markdown"), ""]
+    parts += ["Per-episode outcomes: `outcomes.parquet`, `outcomes.csv`; metrics: `metrics.csv`.", ""]
+    return parts
+
+
+def _section_costs(results: dict, es, rollouts: dict, cfg, out: Path) -> list[str]:
+    parts: list[str] = []
+    cs = study_costs(es, rollouts, results.get("in_loop"), cfg, out)
+    results["costs"] = cs
+    res = cs["offline"]
+    fl = res["flips"]
+    parts += ["## Cost-weight sensitivity", "",
+              f"Offline: the stored outcomes re-weighted under {len(res['costs'])} cost vectors (row 0 locked, "
+              f"row 1 uniform, the rest uniform on the simplex scaled to the locked sum). WSR@1.5 in %.", "",
+              M.md_table(cs["offline_table"][0], [[r[0]] + [100 * v if i < 5 else v for i, v in enumerate(r[1:])]
+                                                for r in cs["offline_table"][1]]), "",
+              f"The ranking differs from the locked-cost ranking for {100 * fl['fraction_flipped']:.1f}% of the "
+              f"cost vectors (mean Kendall tau {fl['tau_mean']:.3f}, min {fl['tau_min']:.3f}). Mean costs where "
+              f"rankings flip: {np.round(fl['mean_costs_flipped'], 3).tolist()}; where they hold: "
+              f"{np.round(fl['mean_costs_kept'], 3).tolist()}.", "",
+              "![WSR against each type's cost](figures/costs_marginal_wsr.png)", "",
+              "![Where rankings flip](figures/costs_flip_map.png)", ""]
+    if "in_loop_table" in cs:
+        h, rows = cs["in_loop_table"]
+        parts += [f"In the loop: `{cs['in_loop_agent']}` re-run under each charged cost vector (one vmapped call "
+                  "over cost vectors x episodes). Its asking should fall as costs rise.", "",
+                  M.md_table(h, rows), "", "![Asking vs costs](figures/costs_in_loop.png)", ""]
+    return parts
+
+
+def _section_difficulty(results: dict, es, rollouts: dict, cfg, out: Path) -> list[str]:
+    ds = study_difficulty(es, rollouts, cfg, out)
+    results["difficulty"] = ds
+    abl = ds["ablation"]
+    p = ds["default_proportions"]
+    parts = ["## Difficulty-coefficient ablation", "",
+             f"{len(abl['alphas'])} alpha settings on the simplex x {len(abl['thresholds'])} threshold pairs "
+             f"({ds['n_settings']} settings), on the stored factors. Per-bin SR is ordered easy >= medium >= hard "
+             f"for every agent in {100 * abl['fraction_ordered']:.1f}% of the settings "
+             f"(empty-bin rule: {cfg.difficulty.empty}). The reference alpha {tuple(cfg.difficulty.alpha)} and "
+             f"thresholds {tuple(cfg.difficulty.thresholds)} give bins "
+             f"{100 * p[0]:.0f}/{100 * p[1]:.0f}/{100 * p[2]:.0f}% of the episodes.", "",
+             M.md_table(*ds["default_bins"]), "", "![Ordering](figures/difficulty_ordering.png)", "",
+             "Calibration (alpha maximising the Spearman correlation between D and failure, mean over agents; "
+             "fitted on one half of the episodes, reported on the other):", "",
+             M.md_table(*ds["calibration_table"]), "", "![Calibration](figures/difficulty_calibration.png)", ""]
+    return parts
+
+
+def _section_derive_costs(results: dict, es, rollouts: dict, cfg, out: Path) -> list[str]:
+    dc = study_derive_costs(cfg, out)
+    results["derive-costs"] = dc
+    parts = ["## Cost derivation", "",
+             f"Cue statistics -> U_c = l_s s_c + l_h h_c + l_r r_c -> mention-weighted U_t -> linear rescale into "
+             f"the locked penalty range. Input: {dc['source']}."
+             + (f" Cues with assumed statistics (unpublished): {', '.join(map(str, dc['assumed']))}."
+               if dc["assumed"] else ""), "",
+             M.md_table(*dc["table"]), ""]
+    return parts
+
+
+def _section_analysis(results: dict, es, rollouts: dict, cfg, out: Path) -> list[str]:
+    an = study_analysis(es, rollouts, cfg, out)
+    results["analysis"] = an
+    parts = [f"## Interaction analyses (`{an['agent']}`)", "",
+             M.md_table(*an["per_difficulty"]), "",
+             "Where Type-3 questions were asked (classified from the navigation grid):", "",
+             M.md_table(*an["locations"]), "",
+             "![Timing](figures/analysis_timing.png)", "",
+             "![Type-3 locations](figures/analysis_type3_locations.png)", "",
+             "![Questions per difficulty](figures/analysis_questions_per_difficulty.png)", "",
+             "![Delta-U](figures/analysis_delta_u.png)", ""]
+    for p in an["trajectory_plots"]:
+        parts += [f"![trajectory]({p.relative_to(out).as_posix()})", ""]
+    return parts
+
+
+SECTIONS = MappingProxyType({
+    "eval": _section_eval,
+    "costs": _section_costs,
+    "difficulty": _section_difficulty,
+    "derive-costs": _section_derive_costs,
+    "analysis": _section_analysis,
+})
+"""Study name -> its report section: runs the study's tables and figures on
+the sweep's results and returns the section's markdown lines. The order is
+the report's (and :data:`ignjax.sweep.cli.STUDIES`', which lists the same
+names without importing the studies). A new study is one module in
+:mod:`ignjax.studies` plus one entry here and in ``STUDIES``."""
+
+
 def write_outputs(results: dict, out: Path) -> None:
     """Run the table-and-figure part of each study in ``results["studies"]`` and write ``report.md``."""
     cfg, studies = results["config"], results["studies"]
@@ -317,76 +415,11 @@ def write_outputs(results: dict, out: Path) -> None:
                   f"({', '.join(f'{counts[b]} {b}' for b in BIN_NAMES)}); seed {cfg.run.seed}; "
                   f"locked costs {tuple(cfg.eval.costs)}; success = geodesic distance <= threshold"
                   f"{' and STOP' if cfg.eval.require_stop else ''}.", ""]
-    if "eval" in studies:
-        ev = study_eval(es, rollouts, cfg, out)
-        results["eval"] = ev
-        parts += ["## Evaluation (Table-1 columns)", "",
-                  "SR/OSR and WSR in %, NE and TL in metres, Q_t questions per episode; the Easy/Medium/Hard columns "
-                  "repeat SR@1.5, WSR@1.5 and |Q| per difficulty. `shortest_path` is privileged (an upper bound).", ""]
-        if all(t in cfg.eval.thresholds for t in (0.5, 1.5, 3.0)):
-            parts += [M.table1(ev["metrics"], "markdown"), ""]
-        parts += ["Per-episode outcomes: `outcomes.parquet`, `outcomes.csv`; metrics: `metrics.csv`.", ""]
-    if "costs" in studies:
-        cs = study_costs(es, rollouts, results.get("in_loop"), cfg, out)
-        results["costs"] = cs
-        res = cs["offline"]
-        fl = res["flips"]
-        parts += ["## Cost-weight sensitivity", "",
-                  f"Offline: the stored outcomes re-weighted under {len(res['costs'])} cost vectors (row 0 locked, "
-                  f"row 1 uniform, the rest uniform on the simplex scaled to the locked sum). WSR@1.5 in %.", "",
-                  M.md_table(cs["offline_table"][0], [[r[0]] + [100 * v if i < 5 else v for i, v in enumerate(r[1:])]
-                                                    for r in cs["offline_table"][1]]), "",
-                  f"The ranking differs from the locked-cost ranking for {100 * fl['fraction_flipped']:.1f}% of the "
-                  f"cost vectors (mean Kendall tau {fl['tau_mean']:.3f}, min {fl['tau_min']:.3f}). Mean costs where "
-                  f"rankings flip: {np.round(fl['mean_costs_flipped'], 3).tolist()}; where they hold: "
-                  f"{np.round(fl['mean_costs_kept'], 3).tolist()}.", "",
-                  "![WSR against each type's cost](figures/costs_marginal_wsr.png)", "",
-                  "![Where rankings flip](figures/costs_flip_map.png)", ""]
-        if "in_loop_table" in cs:
-            h, rows = cs["in_loop_table"]
-            parts += [f"In the loop: `{cs['in_loop_agent']}` re-run under each charged cost vector (one vmapped call "
-                      "over cost vectors x episodes). Its asking should fall as costs rise.", "",
-                      M.md_table(h, rows), "", "![Asking vs costs](figures/costs_in_loop.png)", ""]
-    if "difficulty" in studies:
-        ds = study_difficulty(es, rollouts, cfg, out)
-        results["difficulty"] = ds
-        abl = ds["ablation"]
-        p = ds["default_proportions"]
-        parts += ["## Difficulty-coefficient ablation", "",
-                  f"{len(abl['alphas'])} alpha settings on the simplex x {len(abl['thresholds'])} threshold pairs "
-                  f"({ds['n_settings']} settings), on the stored factors. Per-bin SR is ordered easy >= medium >= hard "
-                  f"for every agent in {100 * abl['fraction_ordered']:.1f}% of the settings "
-                  f"(empty-bin rule: {cfg.difficulty.empty}). The reference alpha {tuple(cfg.difficulty.alpha)} and "
-                  f"thresholds {tuple(cfg.difficulty.thresholds)} give bins "
-                  f"{100 * p[0]:.0f}/{100 * p[1]:.0f}/{100 * p[2]:.0f}% of the episodes.", "",
-                  M.md_table(*ds["default_bins"]), "", "![Ordering](figures/difficulty_ordering.png)", "",
-                  "Calibration (alpha maximising the Spearman correlation between D and failure, mean over agents; "
-                  "fitted on one half of the episodes, reported on the other):", "",
-                  M.md_table(*ds["calibration_table"]), "", "![Calibration](figures/difficulty_calibration.png)", ""]
-    if "derive-costs" in studies:
-        dc = study_derive_costs(cfg, out)
-        results["derive-costs"] = dc
-        parts += ["## Cost derivation", "",
-                  f"Cue statistics -> U_c = l_s s_c + l_h h_c + l_r r_c -> mention-weighted U_t -> linear rescale into "
-                  f"the locked penalty range. Input: {dc['source']}."
-                  + (f" Cues with assumed statistics (unpublished): {', '.join(map(str, dc['assumed']))}."
-                     if dc["assumed"] else ""), "",
-                  M.md_table(*dc["table"]), ""]
-    if "analysis" in studies:
-        an = study_analysis(es, rollouts, cfg, out)
-        results["analysis"] = an
-        parts += [f"## Interaction analyses (`{an['agent']}`)", "",
-                  M.md_table(*an["per_difficulty"]), "",
-                  "Where Type-3 questions were asked (classified from the navigation grid):", "",
-                  M.md_table(*an["locations"]), "",
-                  "![Timing](figures/analysis_timing.png)", "",
-                  "![Type-3 locations](figures/analysis_type3_locations.png)", "",
-                  "![Questions per difficulty](figures/analysis_questions_per_difficulty.png)", "",
-                  "![Delta-U](figures/analysis_delta_u.png)", ""]
-        for p in an["trajectory_plots"]:
-            parts += [f"![trajectory]({p.relative_to(out).as_posix()})", ""]
+    for name, section in SECTIONS.items():
+        if name in studies:
+            parts += section(results, es, rollouts, cfg, out)
     atomic_write(out / "report.md", "\n".join(parts))
 
 
-__all__ = ["agent_arrays", "factors_of", "in_loop_costs", "plot_trajectories", "study_analysis", "study_costs",
+__all__ = ["SECTIONS", "agent_arrays", "factors_of", "in_loop_costs", "plot_trajectories", "study_analysis", "study_costs",
            "study_derive_costs", "study_difficulty", "study_eval", "write_csv", "write_outputs"]

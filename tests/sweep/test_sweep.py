@@ -290,3 +290,10 @@ def test_checkpoint_stage_is_absent_until_complete(tmp_path):
     assert ck.has("eval/x") and not stale.exists()
     got = ck.load("eval/x")
     assert np.array_equal(got["out"]["a"], tree["out"]["a"]) and np.array_equal(got["costs"], tree["costs"])
+
+
+def test_every_study_has_one_report_section_in_the_same_order():
+    from ignjax.sweep.cli import STUDIES
+    from ignjax.sweep.report import SECTIONS
+
+    assert tuple(SECTIONS) == STUDIES

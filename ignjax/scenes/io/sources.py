@@ -19,15 +19,13 @@ import gzip
 import json
 import os
 from pathlib import Path
+from types import MappingProxyType
 
 from ignjax.errors import SceneError
 from ignjax.scenes.io.formats import JSON_SUFFIXES, MESH_SUFFIXES, SIDECAR_SUFFIX, USD_SUFFIXES
 from ignjax.scenes.io.manifest import read_manifest
 from ignjax.scenes.model import Scene, scene_from_dict
 
-# The readers are imported when a file of their kind is read: importing pxr
-# and trimesh takes seconds (measured ~0.6 s and ~1-3 s here), and most
-# callers read one kind only.
 
 
 def _suffix(path: Path) -> str:
@@ -39,8 +37,8 @@ def _suffix(path: Path) -> str:
 
 
 def is_scene_file(path: str | os.PathLike) -> bool:
-    """True when ``path`` has a suffix this module can read."""
-    return _suffix(Path(path)) in USD_SUFFIXES + MESH_SUFFIXES + JSON_SUFFIXES
+    """True when ``path`` has a suffix one of the :data:`READERS` reads."""
+    return _suffix(Path(path)) in READERS
 
 
 def load_scenes(path: str | os.PathLike) -> list[Scene]:
@@ -61,29 +59,12 @@ def load_scenes(path: str | os.PathLike) -> list[Scene]:
         if not files:
             raise SceneError(p, None, "the directory holds no USD, JSON or mesh scene files")
         return [s for f in files for s in load_scenes(f)]
-    suffix = _suffix(p)
-    # Readers are imported on use: pxr takes about 0.6 s to import, trimesh 1-3 s.
-    if suffix in USD_SUFFIXES:
-        from ignjax.scenes.io.usd.load import load_usd
-
-        return [load_usd(p)]
-    if suffix in MESH_SUFFIXES:
-        from ignjax.scenes.io.meshes import load_mesh_scene
-
-        return [load_mesh_scene(p)]
-    if suffix in (".jsonl", ".jsonl.gz"):
-        from ignjax.scenes.io.procthor import load_procthor
-
-        return load_procthor(p)
-    if suffix in (".json", ".json.gz"):
-        doc = _read_json(p)
-        if isinstance(doc, dict) and doc.get("format") == "ignjax-scene":
-            return [scene_from_dict(doc, str(p))]
-        from ignjax.scenes.io.procthor import load_procthor
-
-        return load_procthor(p)
-    raise SceneError(p, None, f"unsupported file type {suffix or '(none)'!r}: expected USD (.usd/.usda/.usdc/.usdz), "
-                               "JSON (.json/.jsonl/.jsonl.gz: ProcTHOR houses or ignjax scenes) or a mesh (.gltf/.glb/.obj)")
+    reader = READERS.get(_suffix(p))
+    if reader is None:
+        raise SceneError(p, None, f"unsupported file type {_suffix(p) or '(none)'!r}: expected USD "
+                                  "(.usd/.usda/.usdc/.usdz), JSON (.json/.jsonl/.jsonl.gz: ProcTHOR houses or ignjax "
+                                  "scenes) or a mesh (.gltf/.glb/.obj)")
+    return reader(p)
 
 
 def load_scene(path: str | os.PathLike) -> Scene:
@@ -94,7 +75,7 @@ def load_scene(path: str | os.PathLike) -> Scene:
     return scenes[0]
 
 
-def _read_json(p: Path):
+def _json_document(p: Path):
     opener = gzip.open if p.name.lower().endswith(".gz") else open
     try:
         with opener(p, "rt", encoding="utf-8") as f:
@@ -125,3 +106,44 @@ def scene_sources(paths) -> list[tuple[object, Path]]:
         for f in files:
             out += [(s, f) for s in load_scenes(f)]
     return out
+
+
+# Readers, one per kind of source. Each imports its library when a file of its
+# kind is read: importing pxr and trimesh takes seconds (measured ~0.6 s and
+# ~1-3 s here), and most callers read one kind only.
+
+
+def _read_usd(p: Path) -> list[Scene]:
+    from ignjax.scenes.io.usd.load import load_usd
+
+    return [load_usd(p)]
+
+
+def _read_mesh(p: Path) -> list[Scene]:
+    from ignjax.scenes.io.meshes import load_mesh_scene
+
+    return [load_mesh_scene(p)]
+
+
+def _read_procthor(p: Path) -> list[Scene]:
+    from ignjax.scenes.io.procthor import load_procthor
+
+    return load_procthor(p)
+
+
+def _read_json(p: Path) -> list[Scene]:
+    doc = _json_document(p)
+    if isinstance(doc, dict) and doc.get("format") == "ignjax-scene":
+        return [scene_from_dict(doc, str(p))]
+    return _read_procthor(p)
+
+
+READERS = MappingProxyType({
+    **{s: _read_usd for s in USD_SUFFIXES},
+    **{s: _read_mesh for s in MESH_SUFFIXES},
+    ".jsonl": _read_procthor, ".jsonl.gz": _read_procthor,
+    ".json": _read_json, ".json.gz": _read_json,
+})
+"""File suffix -> reader (path -> scenes). A new importer is one module in
+:mod:`ignjax.scenes.io` plus its suffixes here (and in
+:mod:`~ignjax.scenes.io.formats`)."""
