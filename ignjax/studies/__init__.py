@@ -1,6 +1,8 @@
 """Offline studies over evaluation outputs (outcome tables, question traces,
 trajectories, episode difficulty factors).
 
+* :mod:`~ignjax.studies.cost_derivation`: the paper's per-type costs rebuilt
+  from cue statistics (and lambda fitted to the locked costs).
 * :mod:`~ignjax.studies.cost_sensitivity`: WSR re-weighted under up to
   millions of alternative question-cost vectors, agent rankings and where
   they flip relative to the locked costs.
