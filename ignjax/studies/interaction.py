@@ -5,7 +5,7 @@ Type-3 answer shrinks the explored area.
 Inputs
     *Question events* (:func:`events_from_rows` from an outcome table's
     ``trace`` column, or :func:`events_from_trajectory` from a rollout's
-    :class:`~ignjax.sim.rollout.Trajectory`): a dict of flat arrays ``episode``,
+    :class:`~ignjax.sim.types.Trajectory`): a dict of flat arrays ``episode``,
     ``type`` (1..4), ``step`` (0-based planner step of the ASK), ``charged``,
     plus per-episode ``steps_used`` and ``difficulty`` (0 easy, 1 medium,
     2 hard; -1 unknown). *Poses*: ``Trajectory.pose`` (E, S + 1, 3), the pose
@@ -152,7 +152,7 @@ def events_from_trajectory(trajectory, difficulty=None) -> dict:
     """Question events from a rollout's trajectories.
 
     Args:
-        trajectory: a :class:`~ignjax.sim.rollout.Trajectory` (or any object with
+        trajectory: a :class:`~ignjax.sim.types.Trajectory` (or any object with
             ``kind`` (E, S) and ``question`` (E, S)); every ASK step is an
             event (a trajectory does not record whether it was charged, so
             ``charged`` is all True and refused questions are included).

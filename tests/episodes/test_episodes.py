@@ -57,8 +57,9 @@ def bench(small_benchmark):
 
 @pytest.fixture(scope="module")
 def corpus_fields(bench):
-    """Geodesic fields of every corpus target, computed by the loader's own
-    code path (scene bank) rather than by the builder."""
+    """Geodesic fields of every corpus target on the loader's grids (the
+    scene bank of the scenes read back from their USD files), not on the
+    builder's (both use :func:`ignjax.scenes.geodesic.goal_fields`)."""
     from ignjax.episodes.dataset import compute_fields
 
     bank = bench["set"].bank

@@ -11,7 +11,7 @@
 
 The collision and free-space probes of the controller read the per-scene
 probe map of :class:`ignjax.sim.env.World` instead. The exact batched fast
-path for large ray batches is :func:`ignjax.sim.rays.caster.fast_rays`.
+path for large ray batches is :func:`ignjax.sim.rays.fast.fast_rays`.
 """
 
 from __future__ import annotations
