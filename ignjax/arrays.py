@@ -5,6 +5,8 @@ vectors parsed from command-line text."""
 from __future__ import annotations
 
 import dataclasses
+import tomllib
+from typing import Any
 
 import jax
 import jax.numpy as jnp
@@ -68,4 +70,52 @@ def parse_floats(text, n: int, where: str) -> tuple[float, ...]:
     return vals
 
 
-__all__ = ["parse_floats", "pytree_dataclass", "xp"]
+def parse_assignment(item: str, where: str = "--set") -> tuple[str, Any]:
+    """``name=value`` from the command line: the dotted name and the value
+    read as TOML (``3``, ``0.5``, ``true``, ``[1, 2]``, ``"text"``; a bare
+    word is a string).
+
+    Raises:
+        ConfigError: naming ``where``, when there is no ``=`` or no dotted name.
+    """
+    if "=" not in item or "." not in item.split("=", 1)[0]:
+        raise ConfigError(None, where, f"expected section.key=value, got {item!r}")
+    name, raw = item.split("=", 1)
+    try:
+        value = tomllib.loads(f"v = {raw}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = raw
+    return name.strip(), value
+
+
+def field_docs(cls: type) -> dict[str, str]:
+    """``field -> description`` from the ``Attributes:`` section of ``cls``'s
+    docstring (a dataclass documented in the Google style); a docstring
+    without that section may list ``name: text`` lines instead."""
+    docs: dict[str, str] = {}
+    lines = (cls.__doc__ or "").splitlines()
+    start = next((i for i, line in enumerate(lines) if line.strip() == "Attributes:"), None)
+    if start is None:
+        for line in lines:
+            if ":" in line:
+                name, text = line.strip().split(":", 1)
+                if name.isidentifier():
+                    docs[name] = text.strip()
+        return docs
+    indent, name = None, None
+    for line in lines[start + 1:]:
+        if not line.strip():
+            break
+        depth = len(line) - len(line.lstrip())
+        indent = depth if indent is None else indent
+        if depth < indent:
+            break
+        if depth == indent and ":" in line:
+            name, text = line.strip().split(":", 1)
+            docs[name] = text.strip()
+        elif name is not None:
+            docs[name] += " " + line.strip()
+    return docs
+
+
+__all__ = ["field_docs", "parse_assignment", "parse_floats", "pytree_dataclass", "xp"]

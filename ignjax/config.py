@@ -31,9 +31,11 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from ignjax.agents import registry
+from ignjax.agents.params import check_param_value, make_params, param_docs, param_values
+from ignjax.arrays import field_docs, parse_assignment
 from ignjax.episodes.difficulty import validate_alpha, validate_thresholds
 from ignjax.errors import ConfigError
-from ignjax.protocol import DIFFICULTY_ALPHA, DIFFICULTY_THRESHOLDS, LOCKED_COSTS, SUCCESS_THRESHOLDS
+from ignjax.protocol import DIFFICULTY_ALPHA, DIFFICULTY_THRESHOLDS, LOCKED_COSTS, SUCCESS_REQUIRES_STOP, SUCCESS_THRESHOLDS
 from ignjax.sim.types import SimConfig
 from ignjax.studies.cost_sensitivity import validate_costs
 
@@ -152,7 +154,8 @@ class EvalConfig:
         thresholds: success distances tau of the SR / OSR / WSR columns, m; positive and increasing.
         costs: per-type question costs charged by WSR (Type 1 appearance, 2 region, 3 route, 4 confirmation);
             default the paper's locked costs.
-        require_stop: success also requires an explicit STOP.
+        require_stop: success also requires an explicit STOP (Habitat's convention); false: the paper's rule,
+            final distance <= tau however the episode ended (STOP or step budget).
     """
 
     SECTION: ClassVar[str] = "eval"
@@ -161,7 +164,7 @@ class EvalConfig:
     parts: int = 0
     thresholds: tuple[float, ...] = SUCCESS_THRESHOLDS
     costs: tuple[float, ...] = LOCKED_COSTS
-    require_stop: bool = True
+    require_stop: bool = SUCCESS_REQUIRES_STOP
 
     def __post_init__(self):
         _check_fields(self, self.SECTION)
@@ -295,6 +298,53 @@ class AnalysisConfig:
 
 
 @dataclass(frozen=True)
+class AgentsConfig:
+    """Every agent's parameters (TOML tables ``[agents.<name>]``, one per registered agent).
+
+    Attributes:
+        params: agent name -> parameter name -> value, for every agent of
+            :func:`ignjax.agents.registry` (defaults filled in; see
+            :func:`ignjax.agents.params.param_values`). A cost-aware agent's
+            ``costs`` are not here: it plans with the charged ``eval.costs``.
+    """
+
+    SECTION: ClassVar[str] = "agents"
+    params: Any = None
+
+    def __post_init__(self):
+        given = self.params or {}
+        if not isinstance(given, dict):
+            raise ConfigError(None, "agents", f"must be a table of [agents.<name>] tables, got {given!r}")
+        known = registry()
+        full = {}
+        for name in given:
+            if name not in known:
+                raise ConfigError(None, f"agents.{name}", f"unknown agent; known: {', '.join(known)}")
+            if not isinstance(given[name], dict):
+                raise ConfigError(None, f"agents.{name}", "must be a table of parameter = value")
+        for name, agent in known.items():
+            values = dict(param_values(agent))
+            for key, value in given.get(name, {}).items():
+                values[key] = check_param_value(agent, key, value)
+            full[name] = values
+        object.__setattr__(self, "params", full)
+
+    def __eq__(self, other):
+        return isinstance(other, AgentsConfig) and self.params == other.params
+
+    __hash__ = None
+
+    def make(self, name: str, costs=None):
+        """The parameter pytree of agent ``name`` with these values, planning
+        with ``costs`` (the charged costs) if it is cost-aware."""
+        return make_params(registry()[name], self.params[name], costs)
+
+    def used(self, names) -> dict[str, dict[str, Any]]:
+        """``name -> parameters`` of the agents ``names`` (for run.json and report headers)."""
+        return {n: dict(self.params[n]) for n in dict.fromkeys(names)}
+
+
+@dataclass(frozen=True)
 class SweepConfig:
     """The whole configuration of a sweep run (one attribute per section).
 
@@ -307,6 +357,7 @@ class SweepConfig:
         derive_costs: :class:`DeriveCostsConfig` (TOML table ``[derive-costs]``).
         analysis: :class:`AnalysisConfig`.
         sim: the simulator's :class:`ignjax.sim.types.SimConfig`.
+        agents: :class:`AgentsConfig` (tables ``[agents.<name>]``).
     """
 
     run: RunConfig = dataclasses.field(default_factory=RunConfig)
@@ -317,6 +368,7 @@ class SweepConfig:
     derive_costs: DeriveCostsConfig = dataclasses.field(default_factory=DeriveCostsConfig)
     analysis: AnalysisConfig = dataclasses.field(default_factory=AnalysisConfig)
     sim: SimConfig = dataclasses.field(default_factory=SimConfig)
+    agents: AgentsConfig = dataclasses.field(default_factory=AgentsConfig)
 
     def __post_init__(self):
         for f in dataclasses.fields(self):
@@ -326,8 +378,12 @@ class SweepConfig:
 
     def to_dict(self) -> dict[str, dict[str, Any]]:
         """``TOML table -> key -> value`` (lists for tuples): ``run.json``'s ``config``."""
-        return {name: {k: list(v) if isinstance(v, tuple) else v for k, v in dataclasses.asdict(section).items()}
-                for name, section in self.sections().items()}
+        def plain(items):
+            return {k: list(v) if isinstance(v, tuple) else v for k, v in items.items()}
+
+        out = {name: plain(dataclasses.asdict(section)) for name, section in self.sections().items() if name != "agents"}
+        out["agents"] = {name: plain(values) for name, values in self.agents.params.items()}
+        return out
 
     def sections(self) -> dict[str, Any]:
         """``TOML table name -> section object``, in file order."""
@@ -338,12 +394,14 @@ class SweepConfig:
         """Build from ``TOML table -> key -> value`` (missing keys take their defaults)."""
         for name, items in data.items():
             _check_names(name, items, "dict")
-        return cls(**{_ATTR_NAME[name]: SECTIONS[name](**data.get(name, {})) for name in SECTIONS})
+        return cls(**{_ATTR_NAME[name]: (AgentsConfig(data.get(name, {})) if name == "agents"
+                                         else SECTIONS[name](**data.get(name, {}))) for name in SECTIONS})
 
 
 SECTIONS: dict[str, type] = {
     "run": RunConfig, "benchmark": BenchmarkConfig, "eval": EvalConfig, "costs": CostsConfig,
     "difficulty": DifficultyConfig, "derive-costs": DeriveCostsConfig, "analysis": AnalysisConfig, "sim": SimConfig,
+    "agents": AgentsConfig,
 }
 """TOML table name -> section class, in file order."""
 _ATTR_NAME = {name: name.replace("-", "_") for name in SECTIONS}
@@ -361,7 +419,10 @@ QUICK: dict[str, dict[str, Any]] = {
 
 @functools.cache
 def _defaults(section: str) -> dict[str, Any]:
-    """``key -> default value`` of a section (the types its values are checked against)."""
+    """``key -> default value`` of a section (the types its values are checked against);
+    for ``agents.<name>``, that agent's parameters."""
+    if section.startswith("agents."):
+        return AgentsConfig().params[section.split(".", 1)[1]]
     d = SECTIONS[section]()
     return {f.name: getattr(d, f.name) for f in dataclasses.fields(d)}
 
@@ -372,6 +433,14 @@ def _check_names(section: str, items: Any, where: str, text: str | None = None) 
         raise ConfigError(f"{where}:{line}" if line else where, section, f"unknown section; known: {', '.join(SECTIONS)}")
     if not isinstance(items, dict):
         raise ConfigError(where, section, "must be a table of settings")
+    if section == "agents":
+        for name, values in items.items():
+            if name not in registry():
+                line = _line_of(text, f"agents.{name}") if text else None
+                raise ConfigError(f"{where}:{line}" if line else where, f"agents.{name}",
+                                  f"unknown agent; known: {', '.join(registry())}")
+            _check_names_agent(name, values, where, text)
+        return
     for key in items:
         if key not in _defaults(section):
             line = _line_of(text, section, key) if text else None
@@ -411,16 +480,24 @@ def load_toml(path: str | os.PathLike) -> tuple[dict, str]:
         raise ConfigError(f"{p}:{line}" if line else str(p), "toml", f"malformed TOML: {e}") from None
 
 
+def _check_names_agent(name: str, items: Any, where: str, text: str | None) -> None:
+    if not isinstance(items, dict):
+        raise ConfigError(where, f"agents.{name}", "must be a table of parameter = value")
+    for key in items:
+        if key not in _defaults(f"agents.{name}"):
+            line = _line_of(text, f"agents.{name}", key) if text else None
+            check_param_value(registry()[name], key, None, f"{where}:{line}" if line else where)
+
+
 def parse_set(item: str) -> dict:
-    """``section.key=value`` (value in TOML syntax; a bare word is a string)."""
-    if "=" not in item or "." not in item.split("=", 1)[0]:
-        raise ConfigError(None, "--set", f"expected section.key=value, got {item!r}")
-    name, raw = item.split("=", 1)
-    section, key = name.strip().rsplit(".", 1)
-    try:
-        value = tomllib.loads(f"v = {raw}")["v"]
-    except tomllib.TOMLDecodeError:
-        value = raw
+    """``section.key=value`` or ``agents.<name>.key=value`` (value in TOML
+    syntax; a bare word is a string)."""
+    name, value = parse_assignment(item, "--set")
+    section, key = name.rsplit(".", 1)
+    if section.startswith("agents."):
+        agent = section.split(".", 1)[1]
+        _check_names("agents", {agent: {key: value}}, "--set")
+        return {"agents": {agent: {key: value}}}
     if section not in SECTIONS:
         raise ConfigError(None, "--set", f"unknown section {section!r}; known: {', '.join(SECTIONS)}")
     if key not in _defaults(section):
@@ -442,6 +519,14 @@ def resolve(config_file: str | os.PathLike | None = None, sets: list[str] = (), 
     def apply(overrides: dict, where: str, text: str | None = None) -> None:
         for section, items in overrides.items():
             _check_names(section, items, where, text)
+            if section == "agents":
+                for agent, params in items.items():
+                    for key, value in params.items():
+                        line = _line_of(text, f"agents.{agent}", key) if text else None
+                        loc = f"{where}:{line}" if line else where
+                        values["agents"].setdefault(agent, {})[key] = check_param_value(registry()[agent], key, value, loc)
+                        origin[f"agents.{agent}.{key}"] = loc
+                continue
             for key, value in items.items():
                 line = _line_of(text, section, key) if text else None
                 loc = f"{where}:{line}" if line else where
@@ -479,33 +564,11 @@ def fingerprint(cfg: SweepConfig, studies: list[str]) -> str:
 # ---------------------------------------------------------------------------
 
 
-def field_docs(cls: type) -> dict[str, str]:
-    """``field -> description`` from the ``Attributes:`` section of ``cls``'s docstring."""
-    docs: dict[str, str] = {}
-    lines = (cls.__doc__ or "").splitlines()
-    try:
-        start = next(i for i, line in enumerate(lines) if line.strip() == "Attributes:")
-    except StopIteration:
-        return docs
-    indent, name = None, None
-    for line in lines[start + 1:]:
-        if not line.strip():
-            break
-        depth = len(line) - len(line.lstrip())
-        indent = depth if indent is None else indent
-        if depth < indent:
-            break
-        if depth == indent and ":" in line:
-            name, text = line.strip().split(":", 1)
-            docs[name] = text.strip()
-        elif name is not None:
-            docs[name] += " " + line.strip()
-    return docs
-
-
 def _toml_value(v: Any) -> str:
     if isinstance(v, bool):
         return "true" if v else "false"
+    if isinstance(v, float) and not math.isfinite(v):
+        return ("inf" if v > 0 else "-inf") if v == v else "nan"
     if isinstance(v, (int, float)):
         return repr(v)
     if isinstance(v, str):
@@ -516,7 +579,20 @@ def _toml_value(v: Any) -> str:
 def to_toml(cfg: SweepConfig, header: str = "") -> str:
     """``cfg`` as a TOML file: every table and key, each key under its description."""
     out = [f"# {line}".rstrip() for line in header.splitlines()]
+
+    def wrap(text):
+        return textwrap.wrap(text.replace("``", "`"), 110, initial_indent="# ", subsequent_indent="# ")
+
     for name, section in cfg.sections().items():
+        if name == "agents":
+            for agent, values in section.params.items():
+                docs = param_docs(registry()[agent])
+                out += ["", f"[agents.{agent}]"]
+                out += wrap(f"Parameters of the `{agent}` agent (a cost-aware agent's costs are eval.costs).")
+                for key, value in values.items():
+                    out += wrap(docs.get(key, ""))
+                    out.append(f"{key} = {_toml_value(value)}")
+            continue
         docs = field_docs(type(section))
         if out:
             out.append("")

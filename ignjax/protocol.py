@@ -29,6 +29,10 @@ LOCKED_COSTS: tuple[float, float, float, float] = (0.182, 0.162, 0.240, 0.103)
 
 SUCCESS_THRESHOLDS: tuple[float, ...] = (0.5, 1.5, 3.0)
 """Success distances tau (m) of the paper's SR / OSR / WSR columns."""
+SUCCESS_REQUIRES_STOP = False
+"""The paper's success rule (Eq. wsr, §4.1): ``d_e <= tau`` on the final
+distance, whether the episode ended by STOP or by the step budget. True is
+Habitat's convention (success also needs an explicit STOP), an option."""
 
 MAX_STEPS = 20
 """Planner steps per episode (an ASK is a step)."""
@@ -58,7 +62,7 @@ GRID_CELLS = 8
 """The Grounder's grid is GRID_CELLS x GRID_CELLS: columns 1..8 left to right, rows 1..8 bottom to top."""
 
 __all__ = [
-    "QUESTION_TYPES", "N_QUESTION_TYPES", "TYPE_LABELS", "LOCKED_COSTS", "SUCCESS_THRESHOLDS", "MAX_STEPS",
+    "QUESTION_TYPES", "N_QUESTION_TYPES", "TYPE_LABELS", "LOCKED_COSTS", "SUCCESS_THRESHOLDS", "SUCCESS_REQUIRES_STOP", "MAX_STEPS",
     "MAX_QUESTIONS", "COLLISION_DISTANCE", "HINT_LOOKAHEAD", "CONFIRM_RANGE", "DIFFICULTY_ALPHA",
     "DIFFICULTY_THRESHOLDS", "SUBSET_PROPORTIONS", "FACTOR_NAMES", "BIN_NAMES", "BIN_INDEX", "N_VIEWS", "VIEW_NAMES",
     "GRID_CELLS",

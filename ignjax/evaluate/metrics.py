@@ -2,8 +2,9 @@
 
 For success threshold tau (metres) and per-type question costs w:
 
-* ``SR@tau``  = mean over episodes of 1{stopped and d_final <= tau}
-  (``require_stop=False`` drops the STOP requirement);
+* ``SR@tau``  = mean over episodes of 1{d_final <= tau}: the paper's rule
+  (Eq. wsr, §4.1), whether the episode ended by STOP or by the step budget;
+  ``require_stop=True`` also requires an explicit STOP (Habitat's convention);
 * ``OSR@tau`` = mean of 1{min distance along the path <= tau};
 * ``NE``      = mean final distance (m); ``TL`` = mean path length (m);
 * ``Q_t``     = mean number of charged type-t questions, ``|Q|`` their sum;
@@ -28,17 +29,25 @@ import jax.numpy as jnp
 import numpy as np
 
 from ignjax.arrays import xp as _xp
-from ignjax.protocol import BIN_NAMES, LOCKED_COSTS, N_QUESTION_TYPES
+from ignjax.protocol import BIN_NAMES, LOCKED_COSTS, N_QUESTION_TYPES, SUCCESS_REQUIRES_STOP
 from ignjax.protocol import SUCCESS_THRESHOLDS as DEFAULT_THRESHOLDS
 from ignjax.sim.types import OutcomeRow
 
 
-def episode_success(final_distance, stopped, thresholds=DEFAULT_THRESHOLDS, require_stop: bool = True):
+def episode_success(final_distance, stopped, thresholds=DEFAULT_THRESHOLDS, require_stop: bool = SUCCESS_REQUIRES_STOP):
     """(..., E, T) bool: 1{d <= tau} (and stopped, when required)."""
     xp = _xp(final_distance, stopped)
     d = xp.asarray(final_distance)[..., None]
     ok = d <= xp.asarray(thresholds, dtype=d.dtype)
     return ok & xp.asarray(stopped)[..., None] if require_stop else ok
+
+
+def success_rule(require_stop: bool, distance: str = "geodesic") -> str:
+    """One sentence naming the success rule, for report and table headers."""
+    rule = f"success = final {distance} distance <= tau"
+    if require_stop:
+        return rule + " and an explicit STOP (Habitat's convention, not the paper's)"
+    return rule + " (the paper's Eq. wsr; an episode ends by STOP or by the step budget)"
 
 
 def question_discount(n_questions, costs=LOCKED_COSTS):
@@ -71,7 +80,7 @@ def _masked_mean(x, mask, xp, axis):
     return (x * m).sum(axis) / xp.maximum(m.sum(axis), 1)
 
 
-def summarize(outcomes: OutcomeRow, thresholds=DEFAULT_THRESHOLDS, costs=LOCKED_COSTS, require_stop: bool = True,
+def summarize(outcomes: OutcomeRow, thresholds=DEFAULT_THRESHOLDS, costs=LOCKED_COSTS, require_stop: bool = SUCCESS_REQUIRES_STOP,
               groups=None, n_groups: int | None = None) -> dict:
     """All metrics, optionally per group.
 
@@ -79,7 +88,8 @@ def summarize(outcomes: OutcomeRow, thresholds=DEFAULT_THRESHOLDS, costs=LOCKED_
         outcomes: per-episode outcomes with leading dims ``...`` and E episodes.
         thresholds: (T,) success thresholds, metres.
         costs: (4,) per-type question costs.
-        require_stop: success requires an explicit STOP.
+        require_stop: success also requires an explicit STOP (default: the
+            paper's rule, the final distance alone).
         groups: optional (..., E) int group index per episode (e.g.
             ``outcomes.difficulty``); ``n_groups`` groups.
 
@@ -145,7 +155,7 @@ def _fmt_tau(t: float) -> str:
     return f"{t:g}"
 
 
-def metric_row(outcomes: OutcomeRow, thresholds=DEFAULT_THRESHOLDS, costs=LOCKED_COSTS, require_stop: bool = True) -> dict:
+def metric_row(outcomes: OutcomeRow, thresholds=DEFAULT_THRESHOLDS, costs=LOCKED_COSTS, require_stop: bool = SUCCESS_REQUIRES_STOP) -> dict:
     """One agent's metrics as a flat dict of Python floats (percentages for
     SR/OSR/WSR, as the paper reports them), overall and per difficulty."""
     thresholds = tuple(float(t) for t in thresholds)

@@ -41,7 +41,7 @@ import pyarrow.parquet as pq
 from ignjax.errors import InputError
 from ignjax.evaluate import metrics as M
 from ignjax.fileio import atomic_write
-from ignjax.protocol import BIN_INDEX, BIN_NAMES, LOCKED_COSTS, SUCCESS_THRESHOLDS
+from ignjax.protocol import BIN_INDEX, BIN_NAMES, LOCKED_COSTS, SUCCESS_REQUIRES_STOP, SUCCESS_THRESHOLDS
 from ignjax.sim.types import STOP_REASONS, OutcomeRow
 
 COLUMNS: tuple[str, ...] = (
@@ -182,7 +182,7 @@ def to_metric_outcomes(rows: list[dict], distance: str = "geodesic") -> OutcomeR
     )
 
 
-def metric_rows(rows: list[dict], thresholds=SUCCESS_THRESHOLDS, costs=LOCKED_COSTS, require_stop: bool = True,
+def metric_rows(rows: list[dict], thresholds=SUCCESS_THRESHOLDS, costs=LOCKED_COSTS, require_stop: bool = SUCCESS_REQUIRES_STOP,
                 distance: str = "geodesic") -> dict[str, dict]:
     """Agent -> :func:`ignjax.evaluate.metrics.metric_row`, recomputed from table rows."""
     agents: dict[str, list[dict]] = {}

@@ -51,7 +51,10 @@ Protocol (paper §3.3, Appendix C; constants in :class:`~ignjax.sim.types.SimCon
   every MOVE. Type 4 says yes only if the target (or the queried
   candidate, which must then be the target) is visible in the current
   front view within ``confirm_range`` metres; a yes starts the follow-up
-  (stop now within ``stop_radius``, else one closer move then stop).
+  (stop now within ``stop_radius``, else one closer move then stop: the
+  next MOVE turns the follow-up into "stop now"). Answers reach the agent
+  as codes only (:data:`~ignjax.sim.types.AGENT_FIELDS`); the route's
+  world point stays in the state (``SimState.hint_point``).
 * **STOP** ends the episode.
 
 Distances: the geodesic distance to the target is read from the target's
@@ -73,7 +76,7 @@ from ignjax.sim import types as T
 from ignjax.sim.compact import masked_map
 from ignjax.sim.executor import execute_moves, pixel_waypoint
 from ignjax.sim.observation import observe, observe_batch
-from ignjax.sim.oracle import ask, hint_progress
+from ignjax.sim.oracle import ask, describe_upfront, hint_progress
 from ignjax.sim.queries import euclidean_to_target, geodesic_to_target
 from ignjax.sim.world import World
 
@@ -83,21 +86,36 @@ from ignjax.sim.world import World
 # ---------------------------------------------------------------------------
 
 
+NOISE_STREAM = 0x6E6F
+"""Folded into an episode's key for its perception noise (:func:`noise_key`),
+so the noise is independent of the agent's randomness."""
+
+
+def noise_key(key: jax.Array) -> jax.Array:
+    """(2,) uint32 key data of an episode's perception noise, from the episode's key."""
+    return jax.random.key_data(jax.random.fold_in(key, NOISE_STREAM)).reshape(-1)[:2].astype(jnp.uint32)
+
+
 def reset(world: World, episode: T.EpisodeSpec, key: jax.Array | None = None) -> T.SimState:
-    """Initial state of one episode (deterministic; ``key`` is accepted for
-    API symmetry with stochastic environments and unused)."""
-    del key
+    """Initial state of one episode. Deterministic but for the perception
+    noise (``SimConfig.miss_rate``, ``confusion_rate``), drawn from ``key``
+    (the episode's key; None: a fixed key). With
+    ``SimConfig.upfront_description`` the Type-1 and Type-2 facts are given
+    and charged here."""
     cfg = world.config
     start = episode.start.astype(jnp.float32)
     d0 = geodesic_to_target(world, episode, start[:2])
-    return T.SimState(
+    nk = noise_key(jax.random.key(0) if key is None else key)
+    state = T.SimState(
         episode=episode, pose=start, step=jnp.int32(0), n_questions=jnp.zeros(4, jnp.int32), n_refused=jnp.int32(0),
-        n_invalid=jnp.int32(0), trace_type=jnp.zeros(cfg.trace_len, jnp.int32),
-        trace_step=jnp.full(cfg.trace_len, -1, jnp.int32), trace_charged=jnp.zeros(cfg.trace_len, bool),
+        n_invalid=jnp.int32(0), trace_type=jnp.zeros(cfg.trace_slots, jnp.int32),
+        trace_step=jnp.full(cfg.trace_slots, -1, jnp.int32), trace_charged=jnp.zeros(cfg.trace_slots, bool),
         n_trace=jnp.int32(0), path_length=jnp.float32(0.0), min_distance=d0.astype(jnp.float32),
         done=~episode.valid, stop_reason=jnp.int32(T.RUNNING), blocked=jnp.zeros(8, bool), last_move=jnp.float32(0.0),
-        waypoint=start[:2], moves_since_confirm=jnp.int32(0), answers=T.Answer.empty(),
+        waypoint=start[:2], moves_since_confirm=jnp.int32(0), hint_point=jnp.zeros(2, jnp.float32), noise_key=nk,
+        answers=T.Answer.empty(),
     )
+    return describe_upfront(world, state) if cfg.upfront_description else state
 
 
 # ---------------------------------------------------------------------------
@@ -134,12 +152,14 @@ def step_batch(world: World, states: T.SimState, actions: T.Action, chunk: int |
         # MOVE
         pose, moved, dmin, blocked, wp = execute_moves(world, states, act.direction, act.col, act.row, is_move, chunk)
         a = states.answers
-        progress = jax.vmap(lambda e, ans, p0, p1: hint_progress(world, e, ans, p0, p1))(
-            states.episode, a, states.pose[:, :2], pose[:, :2])
+        progress = jax.vmap(lambda e, ans, hp, p0, p1: hint_progress(world, e, ans, hp, p0, p1))(
+            states.episode, a, states.hint_point, states.pose[:, :2], pose[:, :2])
+        # the Type-4 follow-up: after the one closer move, "stop now"
+        follow = jnp.where(a.follow_up == T.FOLLOW_ONE_MOVE, T.FOLLOW_STOP_NOW, a.follow_up).astype(jnp.int32)
         moved_state = dataclasses.replace(
             states, pose=pose, path_length=states.path_length + moved, min_distance=dmin, blocked=blocked,
             last_move=moved, waypoint=wp, moves_since_confirm=states.moves_since_confirm + 1,
-            answers=dataclasses.replace(a, hint_progress=progress),
+            answers=dataclasses.replace(a, hint_progress=progress, follow_up=follow),
         )
         # ASK
         asked_state = masked_map(lambda x: ask(world, *x), is_ask, (states, act.question, act.candidate), states, chunk)

@@ -12,6 +12,7 @@ import math
 import jax
 import jax.numpy as jnp
 
+from ignjax.scenes import vocab
 from ignjax.sim import geometry as G
 from ignjax.sim import types as T
 from ignjax.sim.compact import masked_map
@@ -20,7 +21,9 @@ from ignjax.sim.world import World, march_free, packed_at
 
 
 def observe(world: World, state: T.SimState) -> T.Observation:
-    """What the policy sees (no target identity, pose or distance inside)."""
+    """What the policy sees (no target identity, pose or distance inside).
+    Perception is exact unless ``SimConfig.miss_rate`` / ``confusion_rate``
+    make it noisy (:func:`perception_noise`)."""
     with jax.named_scope("observe"):
         cfg = world.config
         bank = world.bank
@@ -49,8 +52,11 @@ def observe(world: World, state: T.SimState) -> T.Observation:
         eye = jnp.array([pose[0], pose[1], cfg.eye_height], jnp.float32)
         seen = jax.vmap(lambda i: instance_in_sight(world, s, i, eye))(idx) & jnp.isfinite(dist)
         bearing = G.wrap_angle(jnp.arctan2(inst.center[s, idx, 1] - pose[1], inst.center[s, idx, 0] - pose[0]) - pose[2])
-        handle = jnp.where(seen, idx, -1).astype(jnp.int32)
         attrs = jnp.stack([inst.color[s, idx], inst.material[s, idx], inst.size[s, idx], inst.state[s, idx]], -1)
+        if cfg.miss_rate > 0 or cfg.confusion_rate > 0:
+            seen, attrs = perception_noise(cfg, state.noise_key, pose, idx, dist, 2 * jnp.max(inst.half_extents[s, idx], axis=1),
+                                           seen, attrs)
+        handle = jnp.where(seen, idx, -1).astype(jnp.int32)
         pad = cfg.max_visible - K
 
         def padk(x, fill):
@@ -69,6 +75,46 @@ def observe(world: World, state: T.SimState) -> T.Observation:
         )
 
 
+NOISE_RANGE = 3.0
+"""Distance (m) at which ``miss_rate`` / ``confusion_rate`` apply as given (to an object :data:`NOISE_SIZE` across)."""
+NOISE_SIZE = 0.5
+"""Object size (m, largest box extent) at which the noise rates apply as given."""
+ATTRIBUTE_VALUES = (len(vocab.COLORS), len(vocab.MATERIALS), len(vocab.SIZES), len(vocab.STATES))
+"""Number of values of each perceived attribute (colour, material, size, state)."""
+
+
+def perception_noise(cfg: T.SimConfig, key_data, pose, idx, dist, size, seen, attrs):
+    """Noisy perception of the K nearest instances: each instance in sight is
+    missed with probability ``miss_rate * (d / 3 m) * (0.5 m / size)`` and
+    each of its attributes replaced by another value with probability
+    ``confusion_rate`` times the same factor (clipped to [0, 1]).
+
+    The draws are a pure function of the episode's noise key, the instance
+    and the pose rounded to 1 cm and 0.01 rad: the same view gives the same
+    detections (an agent that does not move sees the same thing), and every
+    batch layout the same.
+
+    Returns:
+        (seen (K,) bool, attrs (K, 4) int32).
+    """
+    factor = (dist / NOISE_RANGE) * (NOISE_SIZE / jnp.maximum(size, 0.05))
+    key = jax.random.wrap_key_data(key_data)
+    # keyed on the pose rounded to 1 cm and 0.01 rad: float rounding of the pose (which can differ
+    # between batch layouts) does not redraw the noise
+    for v in jnp.round(pose * 100.0).astype(jnp.int32):
+        key = jax.random.fold_in(key, v.astype(jnp.uint32))
+    keys = jax.vmap(lambda i: jax.random.fold_in(key, i))(idx)
+    u = jax.vmap(lambda k: jax.random.uniform(k, (9,)))(keys)  # Shape: (K, 9): miss, 4 confusions, 4 replacements
+    p_miss = jnp.clip(cfg.miss_rate * factor, 0.0, 1.0)
+    seen = seen & (u[:, 0] >= jnp.where(jnp.isfinite(factor), p_miss, 1.0))
+    n = jnp.asarray(ATTRIBUTE_VALUES, jnp.int32)
+    p_conf = jnp.clip(cfg.confusion_rate * factor, 0.0, 1.0)[:, None]
+    shift = 1 + jnp.floor(u[:, 5:] * (n - 1)).astype(jnp.int32)  # another value: 1..n-1 steps along the list
+    confused = (u[:, 1:5] < p_conf) & (attrs >= 0) & (n > 1)
+    attrs = jnp.where(confused, (attrs + shift) % n, attrs)
+    return seen, attrs.astype(jnp.int32)
+
+
 def state_fields(world: World, state: T.SimState) -> dict:
     """The observation's fields read from the state alone (heading, odometry, budgets, last MOVE)."""
     cfg = world.config
@@ -76,7 +122,8 @@ def state_fields(world: World, state: T.SimState) -> dict:
     return dict(
         heading=pose[2], odometry=jnp.stack([pose[0] - start[0], pose[1] - start[1], G.wrap_angle(pose[2] - start[2])]),
         goal_category=state.episode.category, steps_left=jnp.int32(cfg.max_steps) - state.step,
-        questions_left=jnp.int32(cfg.max_questions) - jnp.sum(state.n_questions),
+        questions_left=(jnp.int32(cfg.max_questions) - jnp.sum(state.n_questions)) if cfg.question_budget
+        else jnp.int32(cfg.max_steps) - state.step,
         n_questions=state.n_questions, blocked=state.blocked, last_move=state.last_move,
     )
 

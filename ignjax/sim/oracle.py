@@ -92,24 +92,38 @@ def route_facts(world: World, ep: T.EpisodeSpec, pose):
     return label.astype(jnp.int32), sector, landmark.astype(jnp.int32), ~left, end
 
 
+def description_facts(world: World, ep: T.EpisodeSpec) -> dict:
+    """The Type-1 facts (description) and Type-2 facts (goal room and region) of an episode, as answer fields."""
+    goal_label = jnp.where(ep.goal_room >= 0, world.bank.rooms.label[ep.scene, jnp.maximum(ep.goal_room, 0)], -1)
+    return dict(color=ep.fact_attrs[0], material=ep.fact_attrs[1], size=ep.fact_attrs[2], state=ep.fact_attrs[3],
+                on_category=ep.fact_on, near_categories=ep.fact_near, room_label=goal_label.astype(jnp.int32),
+                region_category=ep.region_category)
+
+
+def describe_upfront(world: World, state: T.SimState) -> T.SimState:
+    """The target's full description given at reset (``SimConfig.upfront_description``):
+    the Type-1 and Type-2 facts known, charged as one question of each type
+    (in ``n_questions`` and the budget; not in the question trace)."""
+    a = dataclasses.replace(state.answers, known=state.answers.known.at[:2].set(True), **description_facts(world, state.episode))
+    return dataclasses.replace(state, answers=a, n_questions=state.n_questions.at[:2].add(1))
+
+
 def ask(world: World, state: T.SimState, qtype, candidate) -> T.SimState:
     """Apply one question (charging, budget, caching, facts, follow-up)."""
     cfg = world.config
     ep = state.episode
     a = state.answers
     charged_so_far = jnp.sum(state.n_questions)
-    allowed = charged_so_far < cfg.max_questions
+    allowed = (charged_so_far < cfg.max_questions) if cfg.question_budget else jnp.array(True)
     q = jnp.clip(qtype, 1, 4)
     n_q = state.n_questions.at[q - 1].add(jnp.where(allowed, 1, 0))
-    slot = jnp.minimum(state.n_trace, cfg.trace_len - 1)
+    slot = jnp.minimum(state.n_trace, cfg.trace_slots - 1)
     trace_type = state.trace_type.at[slot].set(q)
     trace_step = state.trace_step.at[slot].set(state.step)
     trace_charged = state.trace_charged.at[slot].set(allowed)
 
     # Type 1 / Type 2 facts (cached; charged every time)
-    t1 = dict(color=ep.fact_attrs[0], material=ep.fact_attrs[1], size=ep.fact_attrs[2], state=ep.fact_attrs[3],
-              on_category=ep.fact_on, near_categories=ep.fact_near)
-    goal_label = jnp.where(ep.goal_room >= 0, world.bank.rooms.label[ep.scene, jnp.maximum(ep.goal_room, 0)], -1)
+    t1 = description_facts(world, ep)
     # Type 3
     label3, sector3, land3, inroom3, point3 = route_facts(world, ep, state.pose)
     # Type 4
@@ -128,11 +142,11 @@ def ask(world: World, state: T.SimState, qtype, candidate) -> T.SimState:
         size=jnp.where(is1, t1["size"], a.size), state=jnp.where(is1, t1["state"], a.state),
         on_category=jnp.where(is1, t1["on_category"], a.on_category),
         near_categories=jnp.where(is1, t1["near_categories"], a.near_categories),
-        room_label=jnp.where(is2, goal_label, a.room_label),
-        region_category=jnp.where(is2, ep.region_category, a.region_category),
+        room_label=jnp.where(is2, t1["room_label"], a.room_label),
+        region_category=jnp.where(is2, t1["region_category"], a.region_category),
         hint_room_label=jnp.where(is3, label3, a.hint_room_label), hint_sector=jnp.where(is3, sector3, a.hint_sector),
         hint_landmark=jnp.where(is3, land3, a.hint_landmark), hint_in_room=jnp.where(is3, inroom3, a.hint_in_room),
-        hint_point=jnp.where(is3, point3, a.hint_point), hint_active=a.hint_active | is3,
+        hint_active=a.hint_active | is3,
         hint_progress=jnp.where(is3, T.HINT_NONE, a.hint_progress),
         confirm=jnp.where(is4, yes.astype(jnp.int32), a.confirm),
         follow_up=jnp.where(is4, follow, a.follow_up),
@@ -141,15 +155,17 @@ def ask(world: World, state: T.SimState, qtype, candidate) -> T.SimState:
         state, n_questions=n_q, n_refused=state.n_refused + jnp.where(allowed, 0, 1), trace_type=trace_type,
         trace_step=trace_step, trace_charged=trace_charged, n_trace=state.n_trace + 1, answers=new,
         moves_since_confirm=jnp.where(is4 & yes, 0, state.moves_since_confirm),
+        hint_point=jnp.where(is3, point3, state.hint_point),
     )
 
 
-def hint_progress(world: World, ep, a: T.Answer, old_xy, new_xy):
-    """() int32 progress code of the active Type-3 hint after a MOVE from ``old_xy`` to ``new_xy``
+def hint_progress(world: World, ep, a: T.Answer, hint_point, old_xy, new_xy):
+    """() int32 progress code of the active Type-3 hint (aimed at the internal
+    ``hint_point``) after a MOVE from ``old_xy`` to ``new_xy``
     (:data:`~ignjax.sim.types.HINT_NONE` when no hint is active)."""
     cfg = world.config
-    d_old = jnp.linalg.norm(old_xy - a.hint_point)
-    d_new = jnp.linalg.norm(new_xy - a.hint_point)
+    d_old = jnp.linalg.norm(old_xy - hint_point)
+    d_new = jnp.linalg.norm(new_xy - hint_point)
     prog = jnp.where(d_new < d_old - 0.1, T.HINT_CLOSER, jnp.where(d_new > d_old + 0.1, T.HINT_FARTHER, T.HINT_SAME))
     prog = jnp.where(d_new <= cfg.hint_reached, T.HINT_REACHED, prog)
     prog = jnp.where(geodesic_to_target(world, ep, new_xy) <= cfg.stop_radius, T.HINT_STOP, prog)

@@ -44,7 +44,7 @@ from ignjax.sim.world import World
 def rollout_episode(world: World, spec: T.EpisodeSpec, agent, params, key: jax.Array):
     """Run one episode to the end. Returns (OutcomeRow, Trajectory, final SimState)."""
     cfg = world.config
-    state = E.reset(world, spec)
+    state = E.reset(world, spec, key)
     obs = E.observe(world, state)
     key, k0 = jax.random.split(key)
     pstate = agent.init(params, obs, k0)
@@ -227,7 +227,7 @@ def rollout_rows(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.Ar
         (OutcomeRow, Trajectory, final SimState) with leading axis B.
     """
     cfg = world.config
-    state = jax.vmap(lambda sp: E.reset(world, sp))(specs)
+    state = jax.vmap(lambda sp, k: E.reset(world, sp, k))(specs, keys)
     obs = jax.vmap(lambda st: E.observe(world, st))(state)
     split = jax.vmap(jax.random.split)(keys)
     pstate = jax.vmap(agent.init)(params, obs, split[:, 1])

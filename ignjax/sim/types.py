@@ -67,7 +67,21 @@ class SimConfig:
         obs_rays_per_view: free-space rays per view in the observation.
         obs_range: range of observation rays and of visibility, m.
         max_visible: visible-instance slots in the observation.
-        trace_len: question-trace slots (attempts, charged or refused).
+        trace_len: question-trace slots (attempts, charged or refused); 0
+            (default): ``max_steps``, one per possible attempt (:attr:`trace_slots`).
+        question_budget: questions beyond ``max_questions`` are refused; false:
+            no question is ever refused (an unbudgeted protocol, as the
+            paper's naive rows read; README "Reading the paper's tables").
+        upfront_description: the agent receives the target's full
+            description (the Type-1 and Type-2 facts) at reset, charged as one
+            Type-1 and one Type-2 question (counted in ``n_questions`` and
+            the budget, not in the question trace).
+        miss_rate: noisy perception: probability that an instance in sight is
+            missed, at 3 m for an object 0.5 m across; it grows linearly with
+            distance and shrinks with size (clipped to [0, 1]). 0: perfect.
+        confusion_rate: noisy perception: probability that each perceived
+            attribute (colour, material, size, state) is replaced by another
+            value, scaled like ``miss_rate``. 0: perfect.
     """
 
     max_steps: int = protocol.MAX_STEPS
@@ -90,10 +104,16 @@ class SimConfig:
     obs_rays_per_view: int = 3
     obs_range: float = 6.0
     max_visible: int = 16
-    trace_len: int = 20
+    trace_len: int = 0
+    question_budget: bool = True
+    upfront_description: bool = False
+    miss_rate: float = 0.0
+    confusion_rate: float = 0.0
 
     def __post_init__(self):
-        for name in ("max_steps", "max_questions", "max_micro_steps", "obs_rays_per_view", "max_visible", "trace_len"):
+        if isinstance(self.trace_len, bool) or not isinstance(self.trace_len, int) or self.trace_len < 0:
+            raise ConfigError(None, "sim.trace_len", f"must be 0 (max_steps) or a positive integer, got {self.trace_len!r}")
+        for name in ("max_steps", "max_questions", "max_micro_steps", "obs_rays_per_view", "max_visible"):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, int) or v < 1:
                 raise ConfigError(None, f"sim.{name}", f"must be a positive integer, got {v!r}")
@@ -102,12 +122,51 @@ class SimConfig:
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0:
                 raise ConfigError(None, f"sim.{name}", f"must be a positive number, got {v!r}")
+        for name in ("question_budget", "upfront_description"):
+            if not isinstance(getattr(self, name), bool):
+                raise ConfigError(None, f"sim.{name}", f"must be true or false, got {getattr(self, name)!r}")
+        for name in ("miss_rate", "confusion_rate"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 <= v <= 1:
+                raise ConfigError(None, f"sim.{name}", f"must be a probability in [0, 1], got {v!r}")
+        for name in ("pullback", "waypoint_tolerance"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0:
+                raise ConfigError(None, f"sim.{name}", f"must be a non-negative number, got {v!r}")
+        heights = self.collision_heights
+        if not isinstance(heights, (list, tuple)) or not heights or any(
+                isinstance(h, bool) or not isinstance(h, (int, float)) or not math.isfinite(h) or h <= 0 for h in heights):
+            raise ConfigError(None, "sim.collision_heights", f"must be a list of positive heights, got {heights!r}")
+        size = self.image_size
+        if not isinstance(size, (list, tuple)) or len(size) != 2 or any(
+                isinstance(v, bool) or not isinstance(v, int) or v < 8 for v in size):
+            raise ConfigError(None, "sim.image_size", f"must be [width, height] in pixels (>= 8), got {size!r}")
         if not 0 < self.hfov < 180:
             raise ConfigError(None, "sim.hfov", f"must lie in (0, 180) degrees, got {self.hfov}")
-        if self.trace_len < self.max_steps:
+        if 0 < self.trace_len < self.max_steps:
             raise ConfigError(None, "sim.trace_len", f"must be >= max_steps ({self.max_steps}) to hold every question attempt")
         object.__setattr__(self, "collision_heights", tuple(float(h) for h in self.collision_heights))
         object.__setattr__(self, "image_size", tuple(int(v) for v in self.image_size))
+
+    @classmethod
+    def from_values(cls, values: dict, where: str | None = None) -> "SimConfig":
+        """A configuration from ``field -> value`` (e.g. ``--set sim.*`` items);
+        an unknown field is an error naming it and the known ones."""
+        known = [f.name for f in dataclasses.fields(cls)]
+        for key in values:
+            if key not in known:
+                raise ConfigError(where, f"sim.{key}", f"unknown key; known: {', '.join(known)}")
+        return cls(**values)
+
+    def to_dict(self) -> dict:
+        """``field -> value`` (lists for tuples), as run.json records it."""
+        return {f.name: list(v) if isinstance(v := getattr(self, f.name), tuple) else v for f in dataclasses.fields(self)}
+
+    @property
+    def trace_slots(self) -> int:
+        """Slots of the question trace: ``trace_len``, or ``max_steps`` when it is 0."""
+        return self.trace_len or self.max_steps
+
 
 
 @pytree_dataclass
@@ -159,11 +218,15 @@ class Answer:
             first turn-off (0 ahead, 2 left, 4 behind, 6 right) at asking time.
         hint_landmark: () int32 Type-3: category of a landmark on the route (-1).
         hint_in_room: () bool Type-3: the route's first 4 m stay in this room.
-        hint_point: (2,) float32 world point 4 m along the route (internal).
         hint_active: () bool, a Type-3 hint is active.
         hint_progress: () int32 progress code (see module docstring).
         confirm: () int32 Type-4: 1 yes, 0 no, -1 not asked.
-        follow_up: () int32 follow-up state after a yes.
+        follow_up: () int32 follow-up state after a yes: 1 stop now, 2 one
+            closer move then stop; after that move it becomes 1.
+
+    Every field is a code or a flag (no float): an answer carries no
+    coordinate, distance, heading or count along the route
+    (:data:`AGENT_FIELDS` gives each field's reason).
     """
 
     known: jax.Array
@@ -181,7 +244,6 @@ class Answer:
     hint_sector: jax.Array
     hint_landmark: jax.Array
     hint_in_room: jax.Array
-    hint_point: jax.Array
     hint_active: jax.Array
     hint_progress: jax.Array
     confirm: jax.Array
@@ -193,7 +255,7 @@ class Answer:
         return Answer(known=jnp.zeros(4, bool), last_type=jnp.int32(0), refused=jnp.array(False), color=m1,
                       material=m1, size=m1, state=m1, on_category=m1, near_categories=jnp.full(3, -1, jnp.int32),
                       room_label=m1, region_category=m1, hint_room_label=m1, hint_sector=m1, hint_landmark=m1,
-                      hint_in_room=jnp.array(False), hint_point=jnp.zeros(2, jnp.float32), hint_active=jnp.array(False),
+                      hint_in_room=jnp.array(False), hint_active=jnp.array(False),
                       hint_progress=jnp.int32(HINT_NONE), confirm=m1, follow_up=jnp.int32(FOLLOW_NONE))
 
 
@@ -242,6 +304,53 @@ class Observation:
     n_questions: jax.Array
     blocked: jax.Array
     last_move: jax.Array
+
+
+AGENT_FIELDS: dict[str, str] = {
+    # Observation: perception and proprioception of the agent itself
+    "Observation.heading": "own yaw from dead reckoning; says nothing about the target",
+    "Observation.odometry": "own displacement since the start (dead reckoning), not a map coordinate of anything else",
+    "Observation.free_space": "depth to the nearest obstacle per view, what the panorama shows",
+    "Observation.visible_handle": "which instances are in sight (opaque ids, the same instance keeps its id); "
+                                  "never says which one is the target",
+    "Observation.visible_category": "perceived category of each instance in sight",
+    "Observation.visible_attrs": "perceived colour / material / size / state of each instance in sight",
+    "Observation.visible_range": "depth of each instance in sight, as the panorama's depth gives it",
+    "Observation.visible_bearing": "direction of each instance in sight relative to the agent",
+    "Observation.visible_view": "panorama view each instance appears in",
+    "Observation.room_label": "the room the agent stands in, as the panorama shows it (a perception stand-in)",
+    "Observation.goal_category": "the instruction ('find a laptop')",
+    "Observation.steps_left": "the agent's own step budget",
+    "Observation.questions_left": "the agent's own question budget",
+    "Observation.n_questions": "questions the agent has been charged so far",
+    "Observation.blocked": "headings the executor found blocked in the last MOVE (written into spatial memory, §3.3)",
+    "Observation.last_move": "how far the last MOVE went (the agent's own motion)",
+    # Answer: what the oracle said, as codes (text in ignjax.sim.oracle_text)
+    "Answer.known": "which question types have been answered",
+    "Answer.last_type": "type of the latest answer",
+    "Answer.refused": "the latest question was refused (budget spent)",
+    "Answer.color": "Type 1: the description's colour",
+    "Answer.material": "Type 1: the description's material",
+    "Answer.size": "Type 1: the description's size word",
+    "Answer.state": "Type 1: the description's state word",
+    "Answer.on_category": "Type 1: what the target stands on",
+    "Answer.near_categories": "Type 1: objects the description says are near it",
+    "Answer.room_label": "Type 2: the goal room's label",
+    "Answer.region_category": "Type 2: the region's anchor object",
+    "Answer.hint_room_label": "Type 3: the room the route leads toward",
+    "Answer.hint_sector": "Type 3: egocentric direction of the way out ('to your left'); no angle, compass word or distance",
+    "Answer.hint_landmark": "Type 3: a landmark on the route",
+    "Answer.hint_in_room": "Type 3: the route's first stretch stays in this room",
+    "Answer.hint_active": "Type 3: a spatial hint is active",
+    "Answer.hint_progress": "Type 3: qualitative progress since the last move (closer / farther / reached / stop-eligible)",
+    "Answer.confirm": "Type 4: yes / no",
+    "Answer.follow_up": "Type 4: the follow-up state after a yes (stop now / one closer move then stop)",
+}
+"""Every field an agent receives (:class:`Observation` and :class:`Answer`)
+with the reason it may have it. The paper withholds from the Planner world
+coordinates, path lengths, compass headings, step counts along the route
+and target distances (§3.3); such facts stay in :class:`SimState` (e.g.
+``hint_point``). A test fails when a field appears without an entry here."""
 
 
 @pytree_dataclass
@@ -301,6 +410,11 @@ class SimState:
         last_move: () float32 metres moved by the last MOVE.
         waypoint: (2,) float32 the last MOVE's waypoint (world).
         moves_since_confirm: () int32 MOVEs since a positive Type-4 answer.
+        hint_point: (2,) float32 world point ``hint_lookahead`` metres along
+            the route of the last Type-3 answer (internal: progress is
+            reported to the agent as a code, never this point).
+        noise_key: (2,) uint32 key data of the episode's perception noise
+            (used only when ``SimConfig.miss_rate`` or ``confusion_rate`` > 0).
         answers: the oracle's answers so far (see :class:`Answer`).
     """
 
@@ -322,6 +436,8 @@ class SimState:
     last_move: jax.Array
     waypoint: jax.Array
     moves_since_confirm: jax.Array
+    hint_point: jax.Array
+    noise_key: jax.Array
     answers: Answer
 
 

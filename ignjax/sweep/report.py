@@ -403,6 +403,17 @@ names without importing the studies). A new study is one module in
 :mod:`ignjax.studies` plus one entry here and in ``STUDIES``."""
 
 
+def _settings(values: dict) -> str:
+    return ", ".join(f"{k}={list(v) if isinstance(v, tuple) else v}" for k, v in values.items())
+
+
+def settings_lines(sim: dict, agents: dict[str, dict]) -> list[str]:
+    """Markdown lines stating the simulator settings and every agent's parameters used (report headers)."""
+    lines = [f"- Simulator: {_settings(sim)}."]
+    lines += [f"- Agent `{name}`: {_settings(values) or 'no parameters'}." for name, values in agents.items()]
+    return lines
+
+
 def write_outputs(results: dict, out: Path) -> None:
     """Run the table-and-figure part of each study in ``results["studies"]`` and write ``report.md``."""
     cfg, studies = results["config"], results["studies"]
@@ -413,13 +424,15 @@ def write_outputs(results: dict, out: Path) -> None:
         counts = {b: sum(r["difficulty"] == b for r in es.records) for b in BIN_NAMES}
         parts += [f"Benchmark: {len(es)} episodes in {len(es.bank.scene_ids)} scenes "
                   f"({', '.join(f'{counts[b]} {b}' for b in BIN_NAMES)}); seed {cfg.run.seed}; "
-                  f"locked costs {tuple(cfg.eval.costs)}; success = geodesic distance <= threshold"
-                  f"{' and STOP' if cfg.eval.require_stop else ''}.", ""]
+                  f"costs charged (and planned with) {tuple(cfg.eval.costs)}; {M.success_rule(cfg.eval.require_stop)}.",
+                  ""]
+        agents = list(dict.fromkeys(list(cfg.eval.agents) + ([cfg.analysis.agent] if "analysis" in studies else [])))
+        parts += settings_lines(cfg.to_dict()["sim"], cfg.agents.used(agents)) + [""]
     for name, section in SECTIONS.items():
         if name in studies:
             parts += section(results, es, rollouts, cfg, out)
     atomic_write(out / "report.md", "\n".join(parts))
 
 
-__all__ = ["SECTIONS", "agent_arrays", "factors_of", "in_loop_costs", "plot_trajectories", "study_analysis", "study_costs",
+__all__ = ["SECTIONS", "settings_lines", "agent_arrays", "factors_of", "in_loop_costs", "plot_trajectories", "study_analysis", "study_costs",
            "study_derive_costs", "study_difficulty", "study_eval", "write_csv", "write_outputs"]

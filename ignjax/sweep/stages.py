@@ -16,6 +16,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from ignjax.agents import get_agent
+from ignjax.agents.params import plans_with_costs
 from ignjax.config import SweepConfig, digest
 from ignjax.episodes.construct import BuildConfig, build_benchmark
 from ignjax.episodes.dataset import load_benchmark
@@ -98,7 +99,9 @@ def run_eval_stage(es, world, agent_name: str, cfg: SweepConfig, ckpt: Checkpoin
             if bar is not None:
                 bar.update(min(cfg.eval.batch, len(es) - c))
 
-    out, traj = run_agent(es, agent_name, batch=cfg.eval.batch, seed=cfg.run.seed, world=world,
+    # a cost-aware agent plans with the costs it is charged (eval.costs)
+    params = cfg.agents.make(agent_name, costs=cfg.eval.costs)
+    out, traj = run_agent(es, agent_name, params=params, batch=cfg.eval.batch, seed=cfg.run.seed, world=world,
                           progress=prog, parts=cfg.eval.parts or None)
     tree = {"out": _to_tree(out), "traj": _to_tree(traj)}
     ckpt.save(name, tree)
@@ -114,11 +117,12 @@ def run_costs_stage(es, world, cfg: SweepConfig, ckpt: Checkpoints, bar=None) ->
             bar.update(len(es) * len(costs))
         return ckpt.load(name)
     agent = get_agent(cfg.costs.agent)
-    base = agent.default_params()
-    if not hasattr(base, "costs"):
+    if not plans_with_costs(agent):
         raise ConfigError(None, "costs.agent", f"{agent.name!r} has no cost parameters to sweep")
+    base = cfg.agents.make(agent.name)
     K = len(costs)
     params = jax.tree.map(lambda x: jnp.broadcast_to(x, (K,) + jnp.shape(x)), base)
+    # each setting plans with the cost vector it is charged
     params = dataclasses.replace(params, costs=jnp.asarray(costs, jnp.float32))
     batch = max(1, cfg.eval.batch // max(1, K // 4))
     parts = []

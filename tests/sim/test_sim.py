@@ -261,7 +261,11 @@ def test_type4_yes_only_for_the_target_in_front_within_range(small_benchmark, sm
             continue  # the reference view sees the target, but the fast march may disagree at a grazing angle
         yes = fns["step"](small_world, st, T.Action.make(T.ASK, question=4, candidate=-1))
         assert int(yes.answers.confirm) == 1
-        assert int(yes.answers.follow_up) in (T.FOLLOW_STOP_NOW, T.FOLLOW_ONE_MOVE)
+        close = float(Q.geodesic_to_target(small_world, spec, st.pose[:2])) <= small_world.config.stop_radius
+        assert int(yes.answers.follow_up) == (T.FOLLOW_STOP_NOW if close else T.FOLLOW_ONE_MOVE)
+        # the one closer move turns the follow-up into "stop now"
+        moved = fns["step"](small_world, yes, T.Action.make(T.MOVE, 0, 4, 2))
+        assert int(moved.answers.follow_up) == T.FOLLOW_STOP_NOW and int(moved.answers.confirm) == 1
         same = fns["step"](small_world, st, T.Action.make(T.ASK, question=4, candidate=int(spec.target)))
         assert int(same.answers.confirm) == 1
         other = fns["step"](small_world, st, T.Action.make(T.ASK, question=4, candidate=int(spec.target) + 1))

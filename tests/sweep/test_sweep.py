@@ -6,20 +6,25 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import json
 import math
 import os
 import signal
 import subprocess
 import sys
 import time
+import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from ignjax.agents import registry
+from ignjax.agents.params import param_values
 from ignjax.config import (CostsConfig, DifficultyConfig, EvalConfig, SweepConfig, default_toml, fingerprint,
                            parse_set, resolve)
 from ignjax.errors import ConfigError, InputError
+from ignjax.protocol import LOCKED_COSTS
 from ignjax.sim.types import SimConfig
 from ignjax.sweep.checkpoints import Checkpoints
 from ignjax.sweep.cli import main
@@ -30,7 +35,7 @@ REPO = Path(__file__).resolve().parents[2]
 
 def _sets(path, out_root) -> list[str]:
     return [f"benchmark.episodes='{path}'", f"run.out='{out_root}'", "eval.agents=['random', 'eig']",
-            "eval.batch=16", "costs.samples=500", "costs.scales=[0.25, 4.0]", "costs.per_type_factor=0.0",
+            "eval.batch=16", "costs.samples=500", "costs.scales=[0.25, 1.0, 4.0]", "costs.per_type_factor=4.0",
             "analysis.trajectories=1"]
 
 
@@ -73,20 +78,74 @@ def test_wsr_columns_recompute_from_outcomes_alone(sweep_run):
     for agent, m in metrics.items():
         mine = [r for r in rows if r["agent"] == agent]
         assert len(mine) == 40
+        assert sweep_run["cfg"].eval.require_stop is False  # the paper's rule by default
         for thr in (1.5, 3.0):
             total = 0.0
             for r in mine:
-                ok = float(r["final_distance"]) <= thr and r["stopped"] in ("True", "true", "1")
+                ok = float(r["final_distance"]) <= thr
                 n = [int(r[f"q{t}"]) for t in range(1, 5)]
                 total += ok * math.exp(-sum(c * k for c, k in zip(costs, n)))
             assert float(m[f"WSR@{thr:g}"]) == pytest.approx(100 * total / len(mine), abs=1e-3)
 
 
 def test_in_loop_asking_falls_as_costs_rise(sweep_run):
+    """Every setting plans with the cost vector it is charged: asking falls as
+    all costs rise, and raising one type's cost lowers that type's asking."""
     table = sweep_run["res"]["costs"]["in_loop_table"]
     header, rows = table
     q = {r[0]: r[header.index("|Q|")] for r in rows}
     assert q["all x0.25"] > q["all x4"], q
+    per = {r[0]: [r[header.index(f"Q{t}")] for t in range(1, 5)] for r in rows}
+    assert [f"Type {t} x4" for t in range(1, 5)] == [r[0] for r in rows[-4:]]
+    for t in range(4):  # the per-type vectors: w_t x 4, the others locked
+        w = rows[3 + t][1:5]
+        assert w[t] == pytest.approx(4 * LOCKED_COSTS[t]) and all(w[s] == pytest.approx(LOCKED_COSTS[s]) for s in range(4) if s != t)
+        assert per[f"Type {t + 1} x4"][t] <= per["all x1"][t], (t, per)
+    assert sum(per[f"Type {t + 1} x4"][t] for t in range(4)) < sum(per["all x1"]), per
+
+
+def test_run_json_and_report_header_record_every_setting(sweep_run):
+    """run.json holds every key of the configuration (every [sim] field and
+    every agent's parameters); the report header states the success rule,
+    the simulator settings and the evaluated agents' parameters."""
+    out, cfg = sweep_run["out"], sweep_run["cfg"]
+    config = json.loads((out / "run.json").read_text())["config"]
+    assert config == json.loads(json.dumps(cfg.to_dict()))
+    assert set(config["sim"]) == {f.name for f in dataclasses.fields(SimConfig)}
+    assert set(config["agents"]) == set(registry())
+    assert set(config["agents"]["eig"]) == set(param_values(registry()["eig"]))
+    head = (out / "report.md").read_text().split("## ", 1)[0]
+    assert "success = final geodesic distance <= tau (the paper's Eq. wsr" in head
+    assert "- Simulator: max_steps=20, max_questions=10," in head and "question_budget=True" in head
+    assert "- Agent `eig`: threshold=" in head and "- Agent `random`: stop_prob=0.05" in head
+
+
+def test_every_sim_field_and_agent_parameter_is_a_config_key():
+    """Each [sim] field and each [agents.<name>] parameter can be set with
+    --set, reaches the typed configuration and run.json's dict, and is a key
+    of sweeps/default.toml."""
+    changed = {"max_steps": 24, "max_questions": 7, "horizon": 2.5, "collision_distance": 0.5,
+               "collision_heights": [0.2, 0.9], "micro_step": 0.4, "max_micro_steps": 6, "eye_height": 1.1,
+               "image_size": [320, 240], "hfov": 80.0, "depth_range": 8.0, "pullback": 0.25, "waypoint_tolerance": 0.2,
+               "hint_lookahead": 3.0, "confirm_range": 2.5, "stop_radius": 0.8, "hint_reached": 0.7,
+               "obs_rays_per_view": 4, "obs_range": 5.0, "max_visible": 12, "trace_len": 30, "question_budget": False,
+               "upfront_description": True, "miss_rate": 0.2, "confusion_rate": 0.1}
+    assert set(changed) == {f.name for f in dataclasses.fields(SimConfig)}, "add the new SimConfig field here"
+    cfg = resolve(None, [f"sim.{k}={json.dumps(v)}" for k, v in changed.items()])
+    assert cfg.sim.to_dict() == changed and cfg.to_dict()["sim"] == changed
+    for name, agent in registry().items():
+        for key, value in param_values(agent).items():
+            new = (not value) if isinstance(value, bool) else (value + 1 if not isinstance(value, tuple) else value)
+            got = resolve(None, [f"agents.{name}.{key}={json.dumps(new)}"])
+            assert got.to_dict()["agents"][name][key] == new
+            leaf = np.asarray(getattr(got.agents.make(name), key))
+            np.testing.assert_allclose(leaf, np.asarray(new, leaf.dtype))
+    toml = tomllib.loads(default_toml())
+    assert set(toml["sim"]) == set(changed)
+    assert {n: set(v) for n, v in toml["agents"].items()} == {n: set(param_values(a)) for n, a in registry().items()}
+    for section, obj in SweepConfig().sections().items():
+        if section != "agents":
+            assert set(toml[section]) == {f.name for f in dataclasses.fields(obj)}, section
 
 
 def test_offline_study_reference_rows(sweep_run):
@@ -113,6 +172,10 @@ def test_resume_after_sigkill_gives_identical_outputs(sweep_run, small_benchmark
             break
         time.sleep(0.2)
     assert proc.poll() is None, "the run ended before it could be interrupted: " + proc.stderr.read().decode()[-2000:]
+    checkpoints = [p for p in ck.iterdir() if p.is_dir() and ".orbax-checkpoint-tmp" not in p.name] if ck.is_dir() else []
+    if not checkpoints:
+        proc.kill()
+        pytest.fail("no checkpoint appeared within 300 s: the kill would not test a resume from one")
     proc.send_signal(signal.SIGKILL)
     proc.wait()
     assert not (out / "report.md").exists()
