@@ -87,9 +87,13 @@ def _sector_likelihood(answer, sectors):
 
 
 def _fold_answers(mem: Memory, obs: T.Observation, answers: T.Answer) -> Memory:
-    """Fold the answer to last step's question (if any) into the belief."""
+    """Fold the answers into the belief: the Type-1 and Type-2 facts once,
+    when they first become known (asked, or given at reset with the upfront
+    description); the answer to last step's Type-3 or Type-4 question."""
     q = mem.last_asked
     fresh = (q > 0) & ~answers.refused & (answers.last_type == q)
+    new1 = answers.known[0] & ~mem.consumed[0]
+    new2 = answers.known[1] & ~mem.consumed[1]
     M = mem.handle.shape[0]
     labels = jnp.arange(N_ROOM_LABELS)[:, None]
     rel = _abs_sector(obs)[None, :]
@@ -113,17 +117,17 @@ def _fold_answers(mem: Memory, obs: T.Observation, answers: T.Answer) -> Memory:
     d4 = jnp.where(yes, jnp.where(onehot, 0.0, -jnp.inf), 0.0)
     rej4 = jnp.where(~yes & (slot >= 0), onehot, False)
     u4 = jnp.where(yes, -jnp.inf, 0.0) * jnp.ones((N_ROOM_LABELS, 8))
-    d = jnp.select([q == 1, q == 2, q == 3, q == 4], [d1, d2, d3, d4], jnp.zeros(M))
-    u = jnp.select([q == 1, q == 2, q == 3, q == 4], [u1, u2, u3, u4], jnp.zeros((N_ROOM_LABELS, 8)))
-    new_hint = fresh & (q == 3)
+    f3, f4 = fresh & (q == 3), fresh & (q == 4)
+    d = jnp.where(new1, d1, 0.0) + jnp.where(new2, d2, 0.0) + jnp.where(f3, d3, 0.0) + jnp.where(f4, d4, 0.0)
+    u = jnp.where(new1, u1, 0.0) + jnp.where(new2, u2, 0.0) + jnp.where(f3, u3, 0.0) + jnp.where(f4, u4, 0.0)
     return dataclasses.replace(
         mem,
-        logw=jnp.where(fresh, mem.logw + d, mem.logw),
-        unseen_logw=jnp.where(fresh, mem.unseen_logw + u, mem.unseen_logw),
-        rejected=mem.rejected | (fresh & (q == 4) & rej4),
-        hint_heading=jnp.where(new_hint, obs.heading + answers.hint_sector.astype(jnp.float32) * (math.pi / 4), mem.hint_heading),
-        has_hint=mem.has_hint | new_hint,
-        pending_stop=mem.pending_stop | (fresh & (q == 4) & yes & (answers.follow_up == T.FOLLOW_ONE_MOVE)),
+        logw=mem.logw + d,
+        unseen_logw=mem.unseen_logw + u,
+        rejected=mem.rejected | (f4 & rej4),
+        hint_heading=jnp.where(f3, obs.heading + answers.hint_sector.astype(jnp.float32) * (math.pi / 4), mem.hint_heading),
+        has_hint=mem.has_hint | f3,
+        consumed=mem.consumed | jnp.stack([new1, new2, f3, f4]),
     )
 
 

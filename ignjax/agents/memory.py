@@ -54,9 +54,11 @@ class Memory:
         last_asked: () int32 question type asked at the previous step (0 none).
         asked_about: () int32 slot a pending Type-4 question was about (-1).
         approach: () int32 slot being approached (-1).
-        pending_stop: () bool, stop at the next decision (Type-4 follow-up).
+        pending_stop: () bool, the Type-4 follow-up's one closer move was made:
+            STOP at the next decision.
         t: () int32 decisions taken.
-        consumed: (4,) bool, answers of each type already folded into the belief.
+        consumed: (4,) bool, answers of each type already folded into the
+            belief (Type 1 and 2 facts are folded once).
     """
 
     visits: jax.Array

@@ -9,6 +9,10 @@ name               asks   privileged  behaviour
 ``explorer``       no     no          explores (free space, unvisited, not backwards), walks
                                       to the nearest instance of the goal category it has
                                       seen and stops there
+``described``      no     no          never asks; the belief agent on what it sees and on the
+                                      target description when the simulator gives it at
+                                      reset (``SimConfig.upfront_description``): the paper's
+                                      no-QA ablation
 ``naive_asker``    yes    no          asks freely, like the paper's unconstrained baselines:
                                       Type 1 and 2 first, Type 4 at every plausible candidate
                                       in front, Type 3 every third step otherwise
@@ -28,7 +32,10 @@ moves: to the most probable candidate when its posterior exceeds ``commit``
 (where route hints point; the explorer is not biased). In the last
 ``DEADLINE_STEPS`` planner steps every belief agent heads for its most
 probable seen candidate and stops there, and its final step is always a
-STOP (ending without one is a certain failure). Because the costs w enter
+STOP (needed when success requires one, ``require_stop``). After a
+positive Type-4 answer the asking agents follow the paper's follow-up:
+STOP at once when the answer says "stop now", else exactly one MOVE toward
+the confirmed candidate and then STOP. Because the costs w enter
 only through EIG / w, raising a cost lowers the asking rate of that type.
 """
 
@@ -114,7 +121,7 @@ def _move_policy(mem: Memory, obs: T.Observation, params: BeliefParams, b, key, 
     j = jnp.argmax(bc)
     seen = jnp.any((mem.handle >= 0) & ~mem.rejected)
     # running out of planner steps: go for the most likely seen candidate, and make the last step a STOP
-    # (success requires a STOP, so ending without one is a certain failure)
+    # (under the STOP-required success rule, ending without one is a certain failure)
     late = (obs.steps_left <= DEADLINE_STEPS) & seen
     committed = (bc[j] >= params.commit) | late
     close = dist[j] <= params.stop_range
@@ -125,7 +132,7 @@ def _move_policy(mem: Memory, obs: T.Observation, params: BeliefParams, b, key, 
     rel, free = explore_direction(mem, obs, bias=head, bias_weight=hint_weight * conc, rng=key)
     explore = move_toward(rel, jnp.clip(free - 0.4, 0.8, 2.5))
     move = jax.tree.map(lambda a, e: jnp.where(committed, a, e), approach, explore)
-    act = jax.tree.map(lambda s, m: jnp.where(stop | mem.pending_stop, s, m), T.Action.make(T.STOP), move)
+    act = jax.tree.map(lambda s, m: jnp.where(stop, s, m), T.Action.make(T.STOP), move)
     return act, j
 
 
@@ -133,18 +140,30 @@ def _belief_init(params, obs, key):
     return observe_memory(Memory.empty(), obs)
 
 
-def _finish(mem: Memory, obs, answers, act: T.Action, asked_about):
+def _finish(mem: Memory, obs, answers, act: T.Action, asked_about, pending_stop=None):
     is_ask = act.kind == T.ASK
     return dataclasses.replace(
         mem, last_asked=jnp.where(is_ask, act.question, 0).astype(jnp.int32),
         asked_about=jnp.where(is_ask & (act.question == 4), asked_about, mem.asked_about).astype(jnp.int32),
-        t=mem.t + 1,
+        t=mem.t + 1, pending_stop=mem.pending_stop if pending_stop is None else pending_stop,
     )
 
 
-def _with_stop_now(answers, mem, act):
-    stop_now = (mem.last_asked == 4) & (answers.confirm == 1) & (answers.follow_up == T.FOLLOW_STOP_NOW)
-    return jax.tree.map(lambda s, a: jnp.where(stop_now, s, a), T.Action.make(T.STOP), act)
+def _follow_up(mem: Memory, obs: T.Observation, answers: T.Answer, act: T.Action):
+    """The Type-4 follow-up (paper §3.3, Appendix safeguards): after a yes,
+    STOP at once when the answer says "stop now"; when it says "one closer
+    move then stop", exactly one MOVE toward the confirmed candidate, then
+    STOP at the next decision. Returns (action, pending_stop)."""
+    yes = (answers.confirm == 1) & (mem.last_asked == 4) & ~answers.refused & (answers.last_type == 4)
+    stop_now = (yes & (answers.follow_up == T.FOLLOW_STOP_NOW)) | mem.pending_stop
+    one_move = yes & (answers.follow_up == T.FOLLOW_ONE_MOVE) & ~mem.pending_stop
+    dist, bearing = candidate_relative(mem, obs)
+    slot = jnp.maximum(mem.asked_about, 0)
+    has = mem.asked_about >= 0
+    closer = move_toward(jnp.where(has, bearing[slot], 0.0), jnp.where(has, jnp.clip(dist[slot] - 0.5, 0.5, 2.5), 1.0))
+    act = jax.tree.map(lambda m, a: jnp.where(one_move, m, a), closer, act)
+    act = jax.tree.map(lambda s, a: jnp.where(stop_now, s, a), T.Action.make(T.STOP), act)
+    return act, one_move
 
 
 # explorer -------------------------------------------------------------------
@@ -166,6 +185,19 @@ EXPLORER = Agent("explorer", _belief_init, _explorer_act, default_belief_params,
                  description="no questions: explores, stops at the nearest instance of the goal category it saw")
 
 
+# described (no questions, uses a description given at reset) -----------------
+
+def _described_act(params, obs, answers, mem, key, priv):
+    mem, b = update_belief(params, obs, answers, mem)
+    act, _ = _move_policy(mem, obs, params, b, key, 0.0)
+    return act, _finish(mem, obs, answers, act, -1)
+
+
+DESCRIBED = Agent("described", _belief_init, _described_act, default_belief_params,
+                  description="no questions: the belief agent on what it sees plus the target description when it is "
+                              "given at reset (sim.upfront_description); the paper's no-QA ablation")
+
+
 # naive asker ------------------------------------------------------------------
 
 def _naive_act(params, obs, answers, mem, key, priv):
@@ -181,8 +213,8 @@ def _naive_act(params, obs, answers, mem, key, priv):
     move, _ = _move_policy(mem, obs, params, b, key, 1.5)
     cand = jnp.where(slot4 >= 0, mem.handle[jnp.maximum(slot4, 0)], -1)
     act = jax.tree.map(lambda a, m: jnp.where(ask, a, m), T.Action.make(T.ASK, question=jnp.maximum(q, 1), candidate=cand), move)
-    act = _with_stop_now(answers, mem, act)
-    return act, _finish(mem, obs, answers, act, slot4)
+    act, pending = _follow_up(mem, obs, answers, act)
+    return act, _finish(mem, obs, answers, act, slot4, pending)
 
 
 NAIVE_ASKER = Agent("naive_asker", _belief_init, _naive_act, default_belief_params, asks=True,
@@ -200,12 +232,12 @@ def _eig_act(params, obs, answers, mem, key, priv):
     move, _ = _move_policy(mem, obs, params, b, key, 2.0)
     cand = jnp.where(slot4 >= 0, mem.handle[jnp.maximum(slot4, 0)], -1)
     act = jax.tree.map(lambda a, m: jnp.where(ask, a, m), T.Action.make(T.ASK, question=q, candidate=cand), move)
-    act = _with_stop_now(answers, mem, act)
-    return act, _finish(mem, obs, answers, act, slot4)
+    act, pending = _follow_up(mem, obs, answers, act)
+    return act, _finish(mem, obs, answers, act, slot4, pending)
 
 
 EIG = Agent("eig", _belief_init, _eig_act, default_belief_params, asks=True,
             description="cost-aware: asks argmax_t EIG_t / w_t when it exceeds a threshold (Eq. 1 on its belief)")
 
 
-__all__ = ["DEADLINE_STEPS", "EIG", "EXPLORER", "NAIVE_ASKER", "PathParams", "RANDOM", "RandomParams", "SHORTEST_PATH"]
+__all__ = ["DEADLINE_STEPS", "DESCRIBED", "EIG", "EXPLORER", "NAIVE_ASKER", "PathParams", "RANDOM", "RandomParams", "SHORTEST_PATH"]

@@ -115,3 +115,20 @@ def test_table1_lists_every_paper_column():
     for col in M.TABLE1_COLUMNS:
         assert col in text
     assert f"{row['WSR@1.5']:.1f}" in text
+
+
+def test_success_distance_option_switches_the_final_distance():
+    """metric_rows(distance=...) judges success on the geodesic (default) or
+    the Euclidean final distance; OSR keeps the geodesic minimum."""
+    from ignjax.evaluate.outcomes import metric_rows
+
+    base = dict(agent="a", episode_id="e", scene_id="s", difficulty="easy", min_distance=2.0, path_length=3.0, steps=5,
+                stopped=True, stop_reason="stop", q1=0, q2=0, q3=0, q4=0, n_questions=0, n_refused=0, n_invalid=0, trace="")
+    rows = [dict(base, final_distance=2.0, final_euclidean=1.0),  # around a wall: far by path, near in a line
+            dict(base, final_distance=1.2, final_euclidean=1.1),
+            dict(base, final_distance=4.0, final_euclidean=3.5)]
+    geo = metric_rows(rows, thresholds=(1.5,))["a"]
+    euc = metric_rows(rows, thresholds=(1.5,), distance="euclidean")["a"]
+    assert geo["SR@1.5"] == pytest.approx(100 / 3) and euc["SR@1.5"] == pytest.approx(200 / 3)
+    assert geo["NE"] == pytest.approx(7.2 / 3) and euc["NE"] == pytest.approx(5.6 / 3)
+    assert geo["OSR@1.5"] == euc["OSR@1.5"] == 0.0
