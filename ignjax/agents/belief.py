@@ -57,6 +57,19 @@ class BeliefParams:
         p_stop: () posterior needed to stop at a candidate without asking.
         stop_range: () distance to a candidate at which the agent stops, m.
         prior_count: () prior expected number of instances of the category.
+        decision_eig: () bool, the EIG agent values a question by what it
+            tells about the agent's decision (which seen candidate, or which
+            direction to explore): the "not seen yet" hypotheses count as one
+            per direction, so the room label of an instance not seen yet is
+            worth nothing until candidates in different rooms are seen.
+            false: Eq. (1) on the full belief.
+        type3_gate: () bool, safeguard 2: Type 3 only at a branch (three or
+            more open directions), in a loop (this spot visited before), in a
+            long corridor, or when the goal room is known but the agent is
+            not in it and has seen no candidate there.
+        recovery_steps: () safeguard 4: after this many decisions without a
+            committed candidate and without any Type-3 answer, ask Type 3
+            (0: off).
     """
 
     costs: jax.Array
@@ -65,12 +78,17 @@ class BeliefParams:
     p_stop: jax.Array
     stop_range: jax.Array
     prior_count: jax.Array
+    decision_eig: jax.Array
+    type3_gate: jax.Array
+    recovery_steps: jax.Array
 
 
 def default_belief_params(**kw) -> BeliefParams:
     base = dict(costs=jnp.asarray(LOCKED_COSTS, jnp.float32), threshold=jnp.float32(2.5), commit=jnp.float32(0.5),
-                p_stop=jnp.float32(0.8), stop_range=jnp.float32(1.0), prior_count=jnp.float32(3.0))
-    base.update({k: jnp.asarray(v, jnp.float32) for k, v in kw.items()})
+                p_stop=jnp.float32(0.8), stop_range=jnp.float32(1.0), prior_count=jnp.float32(3.0),
+                decision_eig=jnp.array(True), type3_gate=jnp.array(True),
+                recovery_steps=jnp.float32(6.0))
+    base.update({k: jnp.asarray(v, base[k].dtype if k in base else jnp.float32) for k, v in kw.items()})
     return BeliefParams(**base)
 
 
@@ -197,6 +215,23 @@ def question_eigs(mem: Memory, obs: T.Observation, answers: T.Answer, b):
     return jnp.maximum(e, 0.0), jnp.where(has, slot, -1)
 
 
+def decision_eigs(mem: Memory, obs: T.Observation, answers: T.Answer, b):
+    """:func:`question_eigs` on the decision's partition of the belief: the
+    "not seen yet" hypotheses of one direction sector count as one (the agent
+    cannot act on the room label of an instance it has not seen), so Type 2
+    loses the information it gives about those labels,
+    ``sum_s B_s H[label | unseen, s]`` with ``B_s`` the unseen mass of
+    sector s. Types 1, 3 and 4 answer alike under every unseen hypothesis of
+    a sector, so their EIG does not change."""
+    e, slot = question_eigs(mem, obs, answers, b)
+    M = mem.handle.shape[0]
+    bu = b[M:].reshape(N_ROOM_LABELS, 8)
+    mass = jnp.sum(bu, axis=0)  # Shape: (8,)
+    within = jnp.sum(mass * _entropy((bu / jnp.maximum(mass, 1e-12)[None]).T, axis=1))
+    e = e.at[1].set(jnp.where(answers.known[1], 0.0, jnp.maximum(e[1] - within, 0.0)))
+    return e, slot
+
+
 def unseen_direction(mem: Memory, b):
     """(heading, concentration): circular mean of the unseen mass over
     absolute sectors, and its resultant length in [0, 1]."""
@@ -220,5 +255,5 @@ def update_belief(params: BeliefParams, obs: T.Observation, answers: T.Answer, m
     return mem, belief(mem, params)
 
 
-__all__ = ["BeliefParams", "N_COLORS", "belief", "default_belief_params", "expected_information_gain",
+__all__ = ["BeliefParams", "N_COLORS", "belief", "decision_eigs", "default_belief_params", "expected_information_gain",
            "question_eigs", "unseen_direction", "update_belief"]

@@ -48,9 +48,9 @@ import jax.numpy as jnp
 
 from ignjax.agents.agent import Agent
 from ignjax.agents.belief import (
-    BeliefParams, default_belief_params, question_eigs, unseen_direction, update_belief,
+    BeliefParams, decision_eigs, default_belief_params, question_eigs, unseen_direction, update_belief,
 )
-from ignjax.agents.memory import N_ROOM_LABELS, Memory, candidate_relative, observe_memory
+from ignjax.agents.memory import N_ROOM_LABELS, Memory, candidate_relative, observe_memory, visit_index
 from ignjax.agents.motion import explore_direction, move_toward
 from ignjax.arrays import pytree_dataclass
 from ignjax.sim import types as T
@@ -223,12 +223,40 @@ NAIVE_ASKER = Agent("naive_asker", _belief_init, _naive_act, default_belief_para
 
 # EIG agent ------------------------------------------------------------------------
 
+def spatial_uncertainty(mem: Memory, obs: T.Observation, answers: T.Answer):
+    """() bool, safeguard 2's situations for a route question: a branch
+    (three or more views open for 2 m), a loop (this spot seen at three or
+    more decisions), a long corridor (open ahead or behind for 3 m, closed
+    at both sides within 1.2 m), or the goal room known while the agent
+    stands elsewhere and has seen no candidate in it."""
+    free = jnp.mean(obs.free_space, axis=1)  # Shape: (8,) views, relative to the heading
+    branch = jnp.sum(free >= 2.0) >= 3
+    ij = visit_index(obs.odometry[:2])
+    loop = mem.visits[ij[1], ij[0]] >= 3
+    corridor = (jnp.maximum(free[0], free[4]) >= 3.0) & (free[2] < 1.2) & (free[6] < 1.2)
+    valid = (mem.handle >= 0) & ~mem.rejected
+    room_known = answers.known[1] & (answers.room_label >= 0)
+    entry = room_known & (obs.room_label != answers.room_label) & ~jnp.any(valid & (mem.room == answers.room_label))
+    return branch | loop | corridor | entry
+
+
 def _eig_act(params, obs, answers, mem, key, priv):
     mem, b = update_belief(params, obs, answers, mem)
-    eigs, slot4 = question_eigs(mem, obs, answers, b)
+    exact, slot4 = question_eigs(mem, obs, answers, b)
+    decided, _ = decision_eigs(mem, obs, answers, b)
+    eigs = jnp.where(params.decision_eig, decided, exact)
+    # safeguard 2: route questions where space is uncertain
+    eigs = eigs.at[2].multiply(jnp.where(params.type3_gate & ~spatial_uncertainty(mem, obs, answers), 0.0, 1.0))
     ratio = eigs / jnp.maximum(params.costs, 1e-6)
     q = jnp.argmax(ratio) + 1
-    ask = (jnp.max(ratio) > params.threshold) & (obs.questions_left > 0) & ~mem.pending_stop
+    has_q = (obs.questions_left > 0) & ~mem.pending_stop
+    ask = (jnp.max(ratio) > params.threshold) & has_q
+    # safeguard 4: moved for a while, no plausible candidate, never asked for spatial guidance
+    M = mem.handle.shape[0]
+    lost = (params.recovery_steps > 0) & (mem.t >= params.recovery_steps) & ~answers.known[2] \
+        & (jnp.max(b[:M]) < params.commit) & has_q
+    q = jnp.where(ask, q, jnp.where(lost, 3, q))
+    ask = ask | lost
     move, _ = _move_policy(mem, obs, params, b, key, 2.0)
     cand = jnp.where(slot4 >= 0, mem.handle[jnp.maximum(slot4, 0)], -1)
     act = jax.tree.map(lambda a, m: jnp.where(ask, a, m), T.Action.make(T.ASK, question=q, candidate=cand), move)

@@ -74,7 +74,10 @@ Delta-U (:func:`delta_u`, paper line ~317)
     segment): ``A = cell^2 * #cells``. ``A_noQA`` = area of the before path,
     ``A_QA`` = area of the after path, ``Delta-U = (A_noQA - A_QA) / A_noQA``
     (A_noQA >= the area of one disc of radius r > 0). Means per difficulty
-    pool the questions of the bin.
+    pool the questions of the bin. A question asked before any horizon
+    exists (at step 0, or at the last step) has m = 0 and is left out, never
+    counted as zero; ASK steps inside either window count as steps that
+    explore nothing, as they do in the episode.
 """
 
 from __future__ import annotations
