@@ -10,6 +10,22 @@ Sub-commands::
 Errors on bad input are printed as one line naming the file, the place in it
 and the reason, and the command exits with status 2 without writing
 half-finished outputs.
+
+``inspect PATH --json`` prints exactly one JSON object on stdout: for one
+scene ``{"source", "scene_id", "format", "up_axis", "meters_per_unit",
+"rooms": [{"id", "label"}], "instances": [...]}``, for a source holding
+several ``{"source", "scenes": [<one object per scene>]}``. ``up_axis`` and
+``meters_per_unit`` are the source's own; every coordinate is in metres in
+ignjax's Z-up frame (floor at z = 0). Each non-structural instance is
+``{"id", "category", "room", "position", "center", "size", "yaw"}``:
+
+* ``position``: the bottom centre of the instance's upright box (the centre
+  of its floor footprint at its lowest point: where it stands), ``[x, y, z]``;
+* ``center``: the centre of the box, ``[x, y, z]``;
+* ``size``: the box's full extents ``[along its x, along its y, height]``;
+* ``yaw``: the box's rotation about +Z in radians (counter-clockwise from
+  +x), which turns its x and y extents into the world;
+* ``room``: the id of the room it is in, or null.
 """
 
 from __future__ import annotations
@@ -68,18 +84,38 @@ def cmd_scenes(args) -> int:
     return 0
 
 
+def _round(values) -> list[float]:
+    return [round(float(v), 6) + 0.0 for v in values]
+
+
+def inspect_summary(scene) -> dict:
+    """The ``inspect --json`` object of one scene (the contract is in this
+    module's docstring): :func:`~ignjax.scenes.model.scene_summary` plus each
+    instance's box as ``center``, ``size`` (full extents) and ``yaw``."""
+    # imported on use, so that --help and the other commands answer at once
+    from ignjax.scenes.model import scene_summary
+
+    doc = scene_summary(scene)
+    boxes = {i.id: i.bbox for i in scene.objects}
+    for item in doc["instances"]:
+        box = boxes[item["id"]]
+        item["center"] = _round(box.center)
+        item["size"] = _round(2.0 * h for h in box.half_extents)
+        item["yaw"] = _round([box.yaw])[0]
+    return doc
+
+
 def cmd_inspect(args) -> int:
     """Summarise any supported scene source."""
     # imported on use, so that --help and the other commands answer at once
     from ignjax.scenes.io.sources import load_scenes
-    from ignjax.scenes.model import scene_summary
 
     scenes = load_scenes(args.path)
     if args.json:
         if len(scenes) == 1:
-            doc = scene_summary(scenes[0])
+            doc = inspect_summary(scenes[0])
         else:
-            doc = {"source": str(args.path), "scenes": [scene_summary(s) for s in scenes]}
+            doc = {"source": str(args.path), "scenes": [inspect_summary(s) for s in scenes]}
         sys.stdout.write(json.dumps(doc) + "\n")
         return 0
     for s in scenes:
@@ -168,7 +204,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     i = sub.add_parser("inspect", help="summarise a scene source (USD, ProcTHOR JSON/JSONL, glTF/GLB/OBJ, scene folder)")
     i.add_argument("path")
-    i.add_argument("--json", action="store_true", help="print exactly one JSON object on stdout")
+    i.add_argument("--json", action="store_true",
+                   help="print exactly one JSON object on stdout; per instance: position (bottom centre of its box), "
+                        "center, size (full box extents) and yaw of its box, metres, Z-up")
     i.set_defaults(func=cmd_inspect)
 
     r = sub.add_parser("render", help="draw a scene's top-down map and render a first-person 8-view panorama")

@@ -38,10 +38,12 @@ def inspect_json(path) -> dict:
     for r in doc["rooms"]:
         assert set(r) == {"id", "label"} and isinstance(r["id"], str) and isinstance(r["label"], str)
     for i in doc["instances"]:
-        assert {"id", "category", "room", "position"} <= set(i)
+        assert {"id", "category", "room", "position", "center", "size", "yaw"} <= set(i)
         assert isinstance(i["id"], str) and isinstance(i["category"], str)
         assert i["room"] is None or isinstance(i["room"], str)
-        assert len(i["position"]) == 3 and all(isinstance(v, float) and math.isfinite(v) for v in i["position"])
+        for key in ("position", "center", "size"):
+            assert len(i[key]) == 3 and all(isinstance(v, float) and math.isfinite(v) for v in i[key]), (key, i)
+        assert all(v >= 0 for v in i["size"]) and isinstance(i["yaw"], float) and math.isfinite(i["yaw"])
     return doc
 
 
@@ -262,6 +264,80 @@ def test_inspect_json_procthor_house(shared_data, procthor_houses, name):
             assert i["room"] == inside[0], o["id"]
             checked += 1
     assert checked > len(objects) // 2
+
+
+# ---------------------------------------------------------------------------
+# inspect on stages written here: the box in the JSON, USD's messages
+# ---------------------------------------------------------------------------
+
+
+def _tilted_box_stage(path: Path) -> Path:
+    from pxr import Gf, Usd, UsdGeom
+
+    st = Usd.Stage.CreateNew(str(path))
+    UsdGeom.SetStageUpAxis(st, "Z")
+    UsdGeom.SetStageMetersPerUnit(st, 0.01)  # centimetres: the JSON is in metres
+    st.SetDefaultPrim(UsdGeom.Xform.Define(st, "/World").GetPrim())
+    x = UsdGeom.Xform.Define(st, "/World/Desk")
+    x.AddTranslateOp().Set(Gf.Vec3d(300.0, 400.0, 25.0))
+    x.AddRotateZOp().Set(30.0)
+    c = UsdGeom.Cube.Define(st, "/World/Desk/Top")
+    c.CreateSizeAttr(1.0)
+    c.AddScaleOp().Set(Gf.Vec3f(200.0, 100.0, 50.0))
+    c2 = UsdGeom.Cube.Define(st, "/World/Stool")
+    c2.CreateSizeAttr(40.0)
+    c2.AddTranslateOp().Set(Gf.Vec3d(-100.0, 0.0, 20.0))
+    st.Save()
+    return path
+
+
+def test_inspect_json_gives_the_box_center_and_size(tmp_path):
+    doc = inspect_json(_tilted_box_stage(tmp_path / "desk.usda"))
+    got = {i["id"]: i for i in doc["instances"]}
+    desk, stool = got["Desk"], got["Stool"]
+    assert desk["center"] == pytest.approx([3.0, 4.0, 0.25], abs=1e-6)
+    assert desk["size"] == pytest.approx([2.0, 1.0, 0.5], abs=1e-6)  # along the box's own x and y, then height
+    assert desk["yaw"] == pytest.approx(math.radians(30.0), abs=1e-6)
+    assert desk["position"] == pytest.approx([3.0, 4.0, 0.0], abs=1e-6)  # the bottom centre of the box
+    assert stool["center"] == pytest.approx([-1.0, 0.0, 0.2], abs=1e-6)
+    assert stool["size"] == pytest.approx([0.4, 0.4, 0.4], abs=1e-6)
+    assert stool["position"] == pytest.approx([-1.0, 0.0, 0.0], abs=1e-6)
+
+
+_USD_INTERNALS = ("pxr", "Tf", "Traceback", "Error in", ".cpp", "_ReportErrors")
+
+
+@pytest.mark.parametrize("kind,reason", [("empty", "empty file"), ("garbage", "not a readable USD file"),
+                                         ("sublayer", "1 asset reference could not be resolved")])
+def test_inspect_usd_errors_are_one_line_without_internals(tmp_path, kind, reason):
+    p = {"empty": tmp_path / "empty.usda", "garbage": tmp_path / "garbage.usda", "sublayer": tmp_path / "shell.usd"}[kind]
+    p.write_text({"empty": "", "garbage": "this is not a USD layer\n" * 40,
+                  "sublayer": "#usda 1.0\n(\n    subLayers = [@./missing_layer.usda@]\n)\n"}[kind])
+    proc = run_build("inspect", p, "--json")
+    line = assert_one_line_error(proc, str(p))
+    assert reason in line and len(line) < len(str(p)) + 220, line
+    assert not any(bad in proc.stderr for bad in _USD_INTERNALS), proc.stderr
+
+
+def test_inspect_summarizes_unresolved_assets_in_one_line(tmp_path):
+    from pxr import Gf, Usd, UsdGeom
+
+    path = tmp_path / "busy.usda"
+    st = Usd.Stage.CreateNew(str(path))
+    UsdGeom.SetStageUpAxis(st, "Z")
+    st.SetDefaultPrim(UsdGeom.Xform.Define(st, "/World").GetPrim())
+    st.GetRootLayer().subLayerPaths.append("./gone_layer.usda")
+    UsdGeom.Cube.Define(st, "/World/Stool").AddTranslateOp().Set(Gf.Vec3d(0.0, 0.0, 1.0))
+    for k in range(6):
+        UsdGeom.Xform.Define(st, f"/World/Lamp_{k}").GetPrim().GetReferences().AddReference(f"./gone_{k}.mtlx")
+    st.Save()
+    proc = run_build("inspect", path, "--json")
+    assert proc.returncode == 0, proc.stderr
+    assert [i["id"] for i in json.loads(proc.stdout)["instances"]] == ["Stool"]
+    lines = [ln for ln in proc.stderr.splitlines() if "could not be resolved" in ln]
+    assert len(lines) == 1 and "7 asset references could not be resolved" in lines[0], proc.stderr
+    assert not any(bad in proc.stderr for bad in _USD_INTERNALS), proc.stderr
+    assert "gone_5.mtlx" not in proc.stderr  # past the examples: counted, not listed
 
 
 # ---------------------------------------------------------------------------

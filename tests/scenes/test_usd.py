@@ -607,6 +607,88 @@ def test_without_rooms_one_room_covers_everything(tmp_path):
     assert room.area > 10
 
 
+def floor_quad(st, path, x0, y0, x1, y1):
+    m = UsdGeom.Mesh.Define(st, path)
+    m.CreatePointsAttr([(x0, y0, 0.0), (x1, y0, 0.0), (x1, y1, 0.0), (x0, y1, 0.0)])
+    m.CreateFaceVertexCountsAttr([4])
+    m.CreateFaceVertexIndicesAttr([0, 1, 2, 3])
+    return m
+
+
+def test_rooms_from_prim_names_and_room_attributes(tmp_path):
+    st = new_stage(tmp_path / "n.usda")
+    # named like rooms, no label anywhere
+    xform(st, "/World/Kitchen")
+    floor_quad(st, "/World/Kitchen/Floor", 0, 0, 4, 3)
+    cube(st, "/World/Kitchen/Table", size=0.8, translate=(2, 1.5, 0.4))
+    cube(st, "/World/Kitchen/Stool", size=0.4, translate=(6, 1, 0.2))  # under Kitchen, over the bedroom's floor
+    xform(st, "/World/Bedroom_2")
+    floor_quad(st, "/World/Bedroom_2/Ground", 5, 0, 9, 3)
+    cube(st, "/World/Bedroom_2/Bed", size=1.0, translate=(8, 1.5, 0.5))
+    xform(st, "/World/LivingRoom")  # no floor: outlined by its objects
+    cube(st, "/World/LivingRoom/Sofa", size=1.0, translate=(0, 10, 0.5))
+    cube(st, "/World/LivingRoom/Armchair", size=0.8, translate=(3, 12, 0.4))
+    xform(st, "/World/living_room")
+    floor_quad(st, "/World/living_room/Floor", 10, 0, 14, 3)
+    # rooms by attribute only (the names say nothing)
+    a = xform(st, "/World/Zone_A").GetPrim()
+    a.CreateAttribute("userProperties:roomType", Sdf.ValueTypeNames.String).Set("Bathroom")
+    floor_quad(st, "/World/Zone_A/Floor", 0, 20, 3, 23)
+    b = xform(st, "/World/Zone_B").GetPrim()
+    b.SetCustomData({"semantic": {"room": "Garage"}})
+    floor_quad(st, "/World/Zone_B/FloorSlab", 10, 20, 16, 26)
+    c = xform(st, "/World/Zone_C").GetPrim()
+    c.CreateAttribute("label", Sdf.ValueTypeNames.String).Set("Hall")
+    floor_quad(st, "/World/Zone_C/Floor", 20, 20, 24, 22)
+    # a generic label that names no room, and a room attribute on a labelled object: objects
+    d = xform(st, "/World/Zone_D").GetPrim()
+    d.CreateAttribute("label", Sdf.ValueTypeNames.String).Set("chair")
+    cube(st, "/World/Zone_D/Geo", size=0.5, translate=(30, 30, 0.25))
+    couch = cube(st, "/World/Couch", size=0.8, translate=(12, 1, 0.4)).GetPrim()
+    isaac_label(couch, "sofa")
+    couch.CreateAttribute("roomType", Sdf.ValueTypeNames.String).Set("kitchen")
+    chair = xform(st, "/World/Chair_01").GetPrim()  # an object that records its room
+    chair.CreateAttribute("room", Sdf.ValueTypeNames.String).Set("Bedroom")
+    cube(st, "/World/Chair_01/Seat", size=0.5, translate=(6, 2, 0.25))
+    # an object named after a room, and one under no room prim standing on the kitchen floor
+    cube(st, "/World/Lamp_Kitchen", size=0.3, translate=(1, 2.5, 0.15))
+    cube(st, "/World/Fridge", size=0.8, translate=(0.5, 0.5, 0.4))
+    st.Save()
+    scene = load_usd(tmp_path / "n.usda")
+    rooms = {r.id: r.label for r in scene.rooms}
+    assert rooms == {"Kitchen": "kitchen", "Bedroom_2": "bedroom", "LivingRoom": "living_room",
+                     "living_room": "living_room", "Zone_A": "bathroom", "Zone_B": "garage", "Zone_C": "hallway"}
+    got = by_id(scene)
+    assert set(got) == {"Table", "Stool", "Bed", "Sofa", "Armchair", "Zone_D", "Couch", "Lamp_Kitchen", "Fridge", "Chair_01"}
+    assert (got["Chair_01"].category, got["Chair_01"].room) == ("chair", "Bedroom_2")
+    assert {k: got[k].room for k in ("Table", "Bed", "Sofa", "Armchair")} == \
+        {"Table": "Kitchen", "Bed": "Bedroom_2", "Sofa": "LivingRoom", "Armchair": "LivingRoom"}
+    assert got["Stool"].room == "Kitchen"  # the room prim it is under wins over the floor it is over
+    assert got["Fridge"].room == "Kitchen" and got["Lamp_Kitchen"].room == "Kitchen"  # by the floor they stand on
+    assert got["Couch"].room == "living_room" and got["Couch"].category == "sofa"
+    assert got["Zone_D"].room is None
+    assert {k: got[k].category for k in ("Table", "Bed", "Fridge", "Lamp_Kitchen")} == \
+        {"Table": "dining_table", "Bed": "bed", "Fridge": "refrigerator", "Lamp_Kitchen": "lamp_kitchen"}
+    kitchen = scene.room("Kitchen")
+    assert set(kitchen.polygon) == {(0, 0), (4, 0), (4, 3), (0, 3)}
+    assert scene.room("LivingRoom").contains(np.array([[0.0, 10.0], [3.0, 12.0]])).all()
+
+
+def test_point_instancer_points_belong_to_the_room_prim_they_are_under(tmp_path):
+    st = new_stage(tmp_path / "pi.usda")
+    xform(st, "/World/Office")
+    floor_quad(st, "/World/Office/Floor", 0, 0, 4, 4)
+    pi = UsdGeom.PointInstancer.Define(st, "/World/Office/Chairs")
+    cube(st, "/World/Office/Chairs/Proto/Chair", size=0.5)
+    pi.CreatePrototypesRel().SetTargets(["/World/Office/Chairs/Proto/Chair"])
+    pi.CreateProtoIndicesAttr([0, 0])
+    pi.CreatePositionsAttr([(1, 1, 0.25), (9, 9, 0.25)])  # the second is outside the office floor
+    st.Save()
+    scene = load_usd(tmp_path / "pi.usda")
+    assert [r.id for r in scene.rooms] == ["Office"] and scene.rooms[0].label == "office"
+    assert [(i.category, i.room) for i in scene.instances] == [("chair", "Office"), ("chair", "Office")]
+
+
 # ---------------------------------------------------------------------------
 # Errors and warnings
 # ---------------------------------------------------------------------------
@@ -686,6 +768,90 @@ def test_missing_sublayer_and_reference_warn_and_continue(tmp_path):
     assert any("gone_sofa.usda" in m and "/World/Sofa" in m for m in messages)
     assert all(w.filename == __file__ for w in record)  # reported at the caller
     assert [i.category for i in scene.instances] == ["stool"]
+
+
+# -- USD's own errors and warnings: one line of ours, never pxr internals ------
+
+_INTERNAL = ("pxr", "Tf", "Traceback", "Error in", ".cpp", "_ReportErrors")
+
+
+def _usd_file(tmp_path: Path, kind: str) -> Path:
+    if kind == "empty":
+        p = tmp_path / "empty.usda"
+        p.write_text("")
+    elif kind == "garbage":
+        p = tmp_path / "garbage.usda"
+        p.write_text("this is not a USD layer\n" * 40)
+    else:  # a .usd whose only content is a sublayer that does not exist
+        p = tmp_path / "shell.usd"
+        p.write_text('#usda 1.0\n(\n    subLayers = [@./missing_layer.usda@]\n)\n')
+    return p
+
+
+@pytest.mark.parametrize("kind,reason", [("empty", "empty file"), ("garbage", "not a readable USD file (not a valid usda layer)"),
+                                         ("sublayer", "no geometry")])
+def test_usd_errors_are_one_short_line(tmp_path, capfd, kind, reason):
+    p = _usd_file(tmp_path, kind)
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        with pytest.raises(SceneError) as e:
+            load_usd(p)
+    message = str(e.value)
+    assert "\n" not in message and message.startswith(str(p)) and reason in message
+    assert len(message) < len(str(p)) + 200
+    assert not any(bad in message for bad in _INTERNAL), message
+    if kind != "sublayer":
+        assert e.value.__suppress_context__  # no chained pxr exception in a traceback either
+    err = capfd.readouterr().err
+    assert not any(bad in err for bad in _INTERNAL), err  # nothing printed by USD itself
+    if kind == "sublayer":
+        assert "1 asset reference could not be resolved, e.g. sublayer missing_layer.usda of shell.usd" in message
+        (w,) = [w for w in record if issubclass(w.category, UsdImportWarning)]
+        assert "missing_layer.usda" in str(w.message) and "\n" not in str(w.message)
+
+
+def test_many_unresolved_assets_are_one_summary_line(tmp_path, capfd):
+    from pxr import UsdShade
+
+    (tmp_path / "look.mtlx").write_text('<?xml version="1.0"?>\n<materialx version="1.38"></materialx>\n')
+    st = new_stage(tmp_path / "busy.usda")
+    st.GetRootLayer().subLayerPaths.append("./gone_layer.usda")
+    cube(st, "/World/Stool", size=0.4, translate=(0, 0, 0.2))
+    for k in range(5):
+        xform(st, f"/World/Lamp_{k}").GetPrim().GetReferences().AddReference(f"./gone_lamp_{k}.usda")
+    UsdShade.Material.Define(st, "/World/Looks/Look").GetPrim().GetReferences().AddReference("./look.mtlx", "/Look")
+    st.Save()
+    capfd.readouterr()  # what USD printed while the test authored the stage
+    with pytest.warns(UsdImportWarning) as record:
+        scene = load_usd(tmp_path / "busy.usda")
+    assert [i.id for i in scene.instances] == ["Stool"]
+    messages = [str(w.message) for w in record]
+    assert len(messages) == 1, messages
+    (summary,) = messages
+    assert "7 asset references could not be resolved (imported without them), e.g. " in summary
+    assert "and 4 more" in summary and "gone_lamp_0.usda (reference on /World/Lamp_0)" in summary
+    assert "\n" not in summary and not any(bad in summary for bad in _INTERNAL)
+    err = capfd.readouterr().err
+    assert "gone_lamp" not in err and not any(bad in err for bad in _INTERNAL), err
+
+
+def test_other_usd_warnings_are_trapped_and_summarized(capfd):
+    from pxr import Tf
+
+    from ignjax.scenes.io.usd.stage import usd_diagnostics, warn_usd_messages
+
+    with usd_diagnostics() as messages:
+        for k in range(6):
+            Tf.Warn(f"odd value {k % 5}")
+        Tf.Warn("Could not open asset @x.usda@ (already reported)")
+    assert capfd.readouterr().err == ""  # USD printed nothing
+    with pytest.warns(UsdImportWarning) as record:
+        warn_usd_messages("s.usda", messages, known=["Could not open asset @x.usda@"])
+    (w,) = record
+    assert str(w.message).startswith("s.usda: USD reported: 5 further messages from USD, e.g. odd value 0; odd value 1; ")
+    with pytest.warns(UsdImportWarning) as record:
+        warn_usd_messages("s.usda", ["odd value 9"])
+    assert [str(w.message) for w in record] == ["s.usda: USD reported: odd value 9"]
 
 
 # ---------------------------------------------------------------------------

@@ -26,8 +26,11 @@ Frame and units
 Instances
     * ``id`` / ``name``: the node name (the glTF node, the OBJ object).
     * ``category``: from the sidecar's ``categories`` (by node name, or by
-      the name of an ancestor node), else :func:`vocab.normalize_category`
-      of the node name, else of the mesh name.
+      the name of an ancestor node; :func:`vocab.normalize_category` of the
+      text given), else :func:`~ignjax.scenes.io.names.category_from_name`
+      of the node name, else of the mesh name (index and side suffixes
+      stripped: ``Chair_01``, ``chair.002``, ``BishopL``, ``light3`` ->
+      ``chair``, ``chair``, ``bishop``, ``light``).
     * ``structural``: the category is structural (:func:`vocab.is_structural`)
       or the node (or an ancestor) is listed in the sidecar's ``structural``.
     * ``yaw``: the node's local +x axis projected onto the floor (0 for an
@@ -82,6 +85,7 @@ from ignjax.errors import SceneError
 from ignjax.scenes import vocab
 from ignjax.scenes.io.footprint import outline_hull
 from ignjax.scenes.io.formats import MESH_SUFFIXES, SIDECAR_SUFFIX
+from ignjax.scenes.io.names import category_from_name
 from ignjax.scenes.model import (  # noqa: I001
     room_containing,
     Attributes,
@@ -430,9 +434,9 @@ def load_mesh_scene(path: str | os.PathLike, *, sidecar: str | os.PathLike | Map
         if category_text is not None:
             category = vocab.normalize_category(category_text)
         else:
-            category = vocab.normalize_category(g.name)
+            category = category_from_name(g.name)
             if category == vocab.UNKNOWN_CATEGORY:
-                category = vocab.normalize_category(parts[0][1])
+                category = category_from_name(parts[0][1])
         structural = vocab.is_structural(category) or any(n in side.structural for n in lineage)
 
         # Heading: the node's local +x projected onto the floor.

@@ -11,6 +11,7 @@ Modules
     ===============  ======================================================
     ``stage``        opening a stage, up axis, unit, semantic labels, the
                      attribute names export and import share, warnings
+                     (USD's own diagnostics trapped and summarised)
     ``mesh``         triangulating faces; meshes of USD's primitives
     ``export``       :func:`save_usd`, :func:`scene_to_stage` (and the
                      exported layout)
@@ -18,7 +19,10 @@ Modules
     ``frames``       world transforms, layer units
     ``traversal``    which prims become instances and rooms
     ``parts``        geometry prims placed in the world
-    ``naming``       categories and room labels from names
+    ``naming``       categories and room labels from labels, room
+                     attributes and names (the name rules themselves are
+                     :mod:`ignjax.scenes.io.names`, shared with the mesh
+                     importer)
     ``instances``    building instances
     ``rooms``        building rooms, walls and doors
     ===============  ======================================================

@@ -114,7 +114,7 @@ class InstanceBuilder:
         prim = owner.prim
         if owner.label and vocab.normalize_category(owner.label) != vocab.UNKNOWN_CATEGORY:
             return vocab.normalize_category(owner.label)
-        return category_chain(owner.label, custom_kind(prim), prim.GetName(), asset_stem(prim, self.stage))
+        return category_chain((owner.label, custom_kind(prim)), (prim.GetName(), asset_stem(prim, self.stage)))
 
     def owner_extra(self, prim) -> dict:
         """The ``ignjax:`` colour/material/size/state attributes authored on the prim."""
@@ -227,8 +227,8 @@ class InstanceBuilder:
                     rel = self.frames.relative(g, proto.GetParent())
                     gprims.append((g, rel @ scale4(self.frames.unit(g, GEOM_ATTRS.get(src.usd_type, ())))))
             root_rel = self.frames.relative(proto, proto.GetParent())
-            category = category_chain(prim_semantic_label(proto), prim_semantic_label(prim), custom_kind(proto),
-                                       proto.GetName(), prim.GetName(), asset_stem(proto, self.stage))
+            category = category_chain((prim_semantic_label(proto), prim_semantic_label(prim), custom_kind(proto)),
+                                       (proto.GetName(), prim.GetName(), asset_stem(proto, self.stage)))
             per_proto.append((gprims, root_rel, category))
         out = []
         for k, (pidx, m) in enumerate(zip(indices, xforms)):

@@ -8,12 +8,23 @@ unit, labels), :mod:`.frames` (transforms and layer units),
 :mod:`.rooms` (building the scene's parts).
 
 Opening
-    ``Usd.Stage.Open(path, load=LoadAll)`` (payloads loaded). Every
-    composition error (a missing sublayer, reference or payload) becomes a
-    :class:`~ignjax.scenes.io.usd.stage.UsdImportWarning` naming the missing asset
-    and the layer or prim that refers to it; whatever composes is imported.
-    An authored ``defaultPrim`` that names no prim is warned about and
-    ignored (all root prims are imported anyway).
+    ``Usd.Stage.Open(path, load=LoadAll)`` (payloads loaded). A file USD
+    cannot open is a :class:`~ignjax.errors.SceneError` of one line naming
+    the file and a short reason (``empty file``, or ``not a readable USD
+    file (<USD's first cause, at most 100 characters>)``), never the
+    library's internals. Composition errors become
+    :class:`~ignjax.scenes.io.usd.stage.UsdImportWarning` and whatever
+    composes is imported: one missing asset (sublayer, reference, payload,
+    a MaterialX document usd-core cannot read) is named with the layer or
+    prim that refers to it; several become one line ``N asset references
+    could not be resolved (imported without them), e.g. a; b; c; and k
+    more``; other composition errors are warned about one by one, or in one
+    summary line when there are more than
+    :data:`~ignjax.scenes.io.usd.stage.MAX_SEPARATE_WARNINGS`. USD's own
+    diagnostics (which it would print to stderr, one line each) are trapped
+    and dropped when they repeat a composition error, else reported the
+    same way. An authored ``defaultPrim`` that names no prim is warned
+    about and ignored (all root prims are imported anyway).
 
 Frame and units
     ``upAxis`` ``Z`` is kept, ``Y`` is rotated to Z-up with
@@ -81,24 +92,51 @@ Which prims are object instances (each geometry prim belongs to exactly one)
        geometry of its prototype.
 
 Rooms
-    A prim whose label names a room (``Kitchen``, ``living room``; not an
-    object category such as ``toilet``), or an ``ignjax`` room prim, is a
-    room. It is a container: below it, floors (geometry named or labelled
-    ``floor``/``ground``, or the room prim's own geometry) make the room's
-    polygon, everything else is furniture by rules 2-4. The polygon is the
-    ``ignjax:polygon`` when stored; else the outline of the floors'
-    upward-facing faces when that is one simple loop; else the convex hull
-    of the floors' footprint; else the convex hull of the boxes of the
-    objects below the room prim. Without any room prim: one room
-    ``room_0`` labelled ``other`` covering the convex hull of all boxes
-    (and walls). ``Instance.room`` is the room whose polygon contains the
-    centre of the instance's box footprint, else the room prim it lies
-    under, else None; restored instances keep their stored room.
+    Room prims are found in this order:
+
+    1. ``ignjax`` room prims written by :func:`~ignjax.scenes.io.usd.export.save_usd`;
+    2. a prim whose semantic class label (as in rule 2 above) names a room
+       (``Kitchen``, ``living room``; not an object category such as
+       ``toilet``: a prim labelled so is an object);
+    3. a prim without a semantic label whose custom string attribute or
+       ``customData`` entry gives a room:
+       :data:`~ignjax.scenes.io.usd.naming.ROOM_KEYS` (``room``,
+       ``roomType``, ``room_type``, ``roomLabel``, ``room_label``,
+       ``roomName``, ``room_name``, ``roomCategory``, ``room_category``;
+       in any namespace, e.g. ``semantic:room``,
+       ``userProperties:roomType``; case, ``_`` and ``-`` ignored) make it
+       a room whatever their value (``other`` when it is no known room
+       name), :data:`~ignjax.scenes.io.usd.naming.LABEL_KEYS` (``label``,
+       ``semanticLabel``) only when their value names a room;
+    4. a prim without a semantic label named like a room
+       (:func:`~ignjax.scenes.io.names.room_label_from_name`: ``Kitchen``,
+       ``Bedroom_2``, ``living_room``, ``LivingRoom``, ``Guest_Bedroom``,
+       ``GameRoom``; not ``Lamp_Kitchen`` or ``KitchenIsland``).
+
+    Rules 3 and 4 apply only to prims that are not part of an object (no
+    labelled or component ancestor), not themselves components, not named
+    like an object that may be a target (``Chair_01`` with
+    ``room = "kitchen"`` is a chair that records its room), and not below
+    another room prim. A room prim is a container: below it, floors
+    (geometry named or labelled ``floor``/``ground``, or the room prim's
+    own geometry) make the room's polygon, everything else is furniture by
+    rules 2-4 of the instance rules. The polygon is the ``ignjax:polygon``
+    when stored; else the outline of the floors' upward-facing faces when
+    that is one simple loop; else the convex hull of the floors' footprint;
+    else the convex hull of the boxes of the objects below the room prim.
+    Without any room prim: one room ``room_0`` labelled ``other`` covering
+    the convex hull of all boxes (and walls). ``Instance.room`` is the room
+    prim the instance (or its PointInstancer) lies under; else the room
+    whose polygon contains the centre of the instance's box footprint;
+    else None. Restored instances keep their stored room.
 
 Categories
-    From the label; else from a custom Kind; else from the prim name; else
-    from the file stem of the asset the prim references or payloads; all
-    through :func:`vocab.normalize_category`. Names that say nothing
+    From the label; else from a custom Kind (both through
+    :func:`vocab.normalize_category`); else from the prim name; else from
+    the file stem of the asset the prim references or payloads (both
+    through :func:`~ignjax.scenes.io.names.category_from_name`, which
+    strips index and side suffixes: ``Chair_01``, ``BishopL``, ``light3``
+    are ``chair``, ``bishop``, ``light``). Names that say nothing
     (``Mesh``, ``Cube``, ``Xform``, ``Geom`` ...) are skipped; the last
     resort is ``"unknown"``. For PointInstancer points: the prototype's
     label, the instancer's label, the prototype's kind, the prototype's
@@ -138,7 +176,10 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
+import re
 from pathlib import Path
+
+from pxr import Pcp
 
 from ignjax.errors import SceneError
 from ignjax.scenes import vocab
@@ -147,9 +188,50 @@ from ignjax.scenes.io.usd.instances import InstanceBuilder
 from ignjax.scenes.io.usd.naming import room_label_of
 from ignjax.scenes.io.usd.parts import authored, token
 from ignjax.scenes.io.usd.rooms import Structure, room_at
-from ignjax.scenes.io.usd.stage import ATTR_KIND, NS, open_stage, stage_meters_per_unit, stage_up_axis, warn_import
+from ignjax.scenes.io.usd.stage import (
+    ATTR_KIND,
+    NS,
+    one_line,
+    open_stage,
+    stage_meters_per_unit,
+    stage_up_axis,
+    summarize,
+    usd_diagnostics,
+    warn_import,
+    warn_usd_messages,
+)
 from ignjax.scenes.io.usd.traversal import Owner, traverse
 from ignjax.scenes.model import Instance, Room, Scene, SceneMeta, validate_scene
+
+
+_ASSET_ERRORS = frozenset(getattr(Pcp, name) for name in (
+    "ErrorType_InvalidAssetPath", "ErrorType_InvalidSublayerPath", "ErrorType_MutedAssetPath") if hasattr(Pcp, name))
+"""Composition errors that are files USD could not find or open."""
+
+
+def _asset_example(message: str) -> str:
+    """A short account of one unresolved asset: its file name and what refers to it."""
+    m = re.search(r"sublayer @([^@]+)@ of layer @([^@]+)@", message)
+    if m:
+        return f"sublayer {_file_name(m.group(1))} of {_file_name(m.group(2))}"
+    m = re.search(r"asset @([^@]+)@ for (\w+) introduced by @[^@]*@<([^>]+)>", message)
+    if m:
+        return f"{_file_name(m.group(1))} ({m.group(2)} on {m.group(3)})"
+    m = re.search(r"@([^@]+)@", message)
+    return _file_name(m.group(1)) if m else (message if len(message) <= 100 else message[:97] + "...")
+
+
+def _file_name(asset: str) -> str:
+    return Path(asset.split(":SDF_FORMAT_ARGS")[0]).name or asset
+
+
+def unresolved_summary(messages: list[str], examples: int = 3, note: str = "") -> str:
+    """``"N asset references could not be resolved<note>, e.g. a; b; c"`` for
+    the messages of unresolved-asset composition errors."""
+    n = len(messages)
+    listed = "; ".join(_asset_example(m) for m in messages[:examples])
+    more = f"; and {n - examples} more" if n > examples else ""
+    return f"{n} asset reference{'s' if n != 1 else ''} could not be resolved{note}, e.g. {listed}{more}"
 
 
 class _Importer:
@@ -173,12 +255,17 @@ class _Importer:
         warn_import(self.spath, message)
 
     def _warn_composition(self) -> None:
-        seen = set()
-        for err in self.stage.GetCompositionErrors():
-            msg = " ".join(str(err).split())
-            if msg not in seen:
-                seen.add(msg)
-                self._warn(f"composition error, imported without it: {msg}")
+        errors = self.stage.GetCompositionErrors()
+        self.composition_texts = [one_line(e) for e in errors]
+        assets = list(dict.fromkeys(one_line(e) for e in errors if e.errorType in _ASSET_ERRORS))
+        others = list(dict.fromkeys(one_line(e) for e in errors if e.errorType not in _ASSET_ERRORS))
+        self.unresolved = assets
+        if len(assets) == 1:
+            self._warn(f"composition error, imported without it: {assets[0]}")
+        elif assets:  # many missing files (MaterialX documents, textures, sublayers): one line
+            self._warn(unresolved_summary(assets, note=" (imported without them)"))
+        for line in summarize(others, "composition errors (imported without what they concern)"):
+            self._warn(f"composition error, imported without it: {line}" if line in others else line)
         layer = self.stage.GetRootLayer()
         if layer.HasDefaultPrim() and not self.stage.GetDefaultPrim():
             self._warn(f"defaultPrim {layer.defaultPrim!r} names no prim; importing all root prims")
@@ -222,12 +309,14 @@ class _Importer:
                         parts, self.frames.frame(prim), build.unique_id(prim.GetName()), build.owner_category(owner),
                         str(prim.GetPath()), build.owner_extra(prim)), False, owner.room))
         for prim in found.instancers:
-            records += [(inst, False, None) for inst in build.pointinstancer_instances(prim)]
+            under = found.instancer_rooms.get(prim.GetPath())
+            records += [(inst, False, under) for inst in build.pointinstancer_instances(prim)]
         walls = [w for w in (structure.wall(p) for k, p in found.specials if k == "wall") if w is not None]
         doors = [d for d in (structure.door(p) for k, p in found.specials if k == "door") if d is not None]
         room_owners = [o for o in found.owners if o.role in ("room", "ignjax_room")]
         if build.n_parts == 0 and not walls and not any(o.gprims for o in room_owners):
-            raise SceneError(self.spath, None, "the stage has no geometry (no meshes or geometric primitives to import)")
+            note = f"; {unresolved_summary(self.unresolved, 1)}" if self.unresolved else ""
+            raise SceneError(self.spath, None, f"the stage has no geometry (no meshes or geometric primitives to import{note})")
         rooms: list[Room] = []
         room_of_owner: dict[int, str] = {}
         room_ids: set[str] = set()
@@ -268,7 +357,7 @@ class _Importer:
             if restored and (inst.room is None or inst.room in room_ids):
                 room = inst.room
             else:
-                room = room_at(scene_rooms, inst.bbox.center[:2]) or room_of_owner.get(id(under))
+                room = room_of_owner.get(id(under)) or room_at(scene_rooms, inst.bbox.center[:2])
             support = inst.support if inst.support in ids else None
             fixed.append(dataclasses.replace(inst, room=room, support=support))
         stored = self.stored_scene()
@@ -321,6 +410,15 @@ def load_usd(path: str | os.PathLike, *, scene_id: str | None = None, correct_la
 
     Warns:
         UsdImportWarning: missing sublayers/references/payloads (the rest is
-            imported), an invalid ``defaultPrim``, skipped prims.
+            imported; many become one summary), an invalid ``defaultPrim``,
+            skipped prims, other messages USD issued during the import.
     """
-    return _Importer(Path(path), scene_id, correct_layer_units).run()
+    importer, reported = None, []
+    try:
+        with usd_diagnostics() as reported:
+            importer = _Importer(Path(path), scene_id, correct_layer_units)
+            return importer.run()
+    finally:
+        if importer is not None:
+            warn_usd_messages(importer.spath, reported, importer.composition_texts)
+

@@ -1,6 +1,6 @@
 """Names in a stage: the object category of a prim (from its label, kind,
-name or referenced asset), whether a label names a room, and whether a
-prim's model kind makes it a component.
+name or referenced asset), whether a label, a room attribute or a prim name
+names a room, and whether a prim's model kind makes it a component.
 """
 
 from __future__ import annotations
@@ -11,6 +11,7 @@ from pathlib import Path
 from pxr import Kind, Pcp, Usd
 
 from ignjax.scenes import vocab
+from ignjax.scenes.io.names import category_from_name, room_label_from_name
 from ignjax.scenes.io.usd.frames import nodes
 
 _BUILTIN_KINDS = frozenset({"model", "group", "assembly", "component", "subcomponent"})
@@ -91,11 +92,102 @@ def asset_stem(prim, stage) -> str | None:
     return None
 
 
-def category_chain(*candidates) -> str:
-    """The first candidate that normalizes to a meaningful category, else ``unknown``."""
-    for c in candidates:
-        if c:
-            cat = _meaningful(vocab.normalize_category(c))
-            if cat:
-                return cat
+def category_chain(labels=(), names=()) -> str:
+    """The first meaningful category: of the ``labels`` (semantic labels,
+    custom kinds; :func:`vocab.normalize_category`), else of the ``names``
+    (prim names, asset stems; :func:`~ignjax.scenes.io.names.category_from_name`),
+    else ``unknown``."""
+    for texts, normalize in ((labels, vocab.normalize_category), (names, category_from_name)):
+        for c in texts:
+            if c:
+                cat = _meaningful(normalize(c))
+                if cat:
+                    return cat
     return vocab.UNKNOWN_CATEGORY
+
+
+ROOM_KEYS = ("room", "roomType", "room_type", "roomLabel", "room_label", "roomName", "room_name",
+             "roomCategory", "room_category")
+"""Attribute and ``customData`` names that say which room a prim *is*: any
+non-empty string value makes the prim a room (labelled ``other`` when the
+value is no known room name). Matched on the name's last ``:`` component,
+ignoring case, ``_`` and ``-``, so ``room``, ``semantic:room``,
+``semantics:roomType`` and ``userProperties:room_label`` all count."""
+LABEL_KEYS = ("label", "semanticLabel", "semantic_label")
+"""Generic label names, matched the same way: they make the prim a room
+only when their value names a room (``label = "Kitchen"`` does,
+``label = "chair"`` does not)."""
+
+
+def _key(name: str) -> str:
+    return re.sub(r"[_-]", "", str(name).rsplit(":", 1)[-1]).lower()
+
+
+_ROOM_KEYS = frozenset(_key(k) for k in ROOM_KEYS)
+_LABEL_KEYS = frozenset(_key(k) for k in LABEL_KEYS)
+
+
+def _text(value) -> str | None:
+    """A string value, or the first non-empty string of a string array, stripped; else None."""
+    if isinstance(value, str):
+        return value.strip() or None
+    if value is not None and not isinstance(value, (bytes, dict)) and hasattr(value, "__iter__"):
+        for v in value:
+            if not isinstance(v, str):
+                return None
+            if v.strip():
+                return v.strip()
+    return None
+
+
+def _flatten(data, prefix: str = ""):
+    """(``outer:inner`` name, value) pairs of nested dictionaries."""
+    for k, v in (data or {}).items():
+        name = f"{prefix}:{k}" if prefix else str(k)
+        if isinstance(v, dict):
+            yield from _flatten(v, name)
+        else:
+            yield name, v
+
+
+def room_attribute_label(prim) -> str | None:
+    """The room label a custom string attribute or ``customData`` entry of
+    the prim gives it, or None.
+
+    Authored attributes are read first (in name order), then ``customData``
+    (nested dictionaries as ``outer:inner``); in each, the :data:`ROOM_KEYS`
+    before the :data:`LABEL_KEYS`.
+    """
+    found: list[tuple[int, str]] = []
+    for name in prim.GetAuthoredPropertyNames():
+        key = _key(name)
+        if key in _ROOM_KEYS or key in _LABEL_KEYS:
+            attr = prim.GetAttribute(name)
+            text = _text(attr.Get()) if attr else None
+            if text:
+                found.append((0 if key in _ROOM_KEYS else 1, text))
+    for name, value in _flatten(prim.GetCustomData()):
+        key = _key(name)
+        text = _text(value)
+        if text and (key in _ROOM_KEYS or key in _LABEL_KEYS):
+            found.append((2 if key in _ROOM_KEYS else 3, text))
+    for rank, text in sorted(found, key=lambda t: t[0]):
+        if rank in (0, 2):
+            return vocab.normalize_room_label(text)
+        label = room_label_of(text)
+        if label:
+            return label
+    return None
+
+
+def names_object(prim) -> bool:
+    """The prim's name is an object category that may be a target
+    (``Chair_01``): such a prim is an object even with a room attribute
+    (objects often record the room they stand in)."""
+    return vocab.is_target_eligible(category_from_name(prim.GetName()))
+
+
+def room_name_label(prim) -> str | None:
+    """The room label the prim's name gives it
+    (:func:`~ignjax.scenes.io.names.room_label_from_name`), or None."""
+    return room_label_from_name(prim.GetName())

@@ -1,10 +1,12 @@
 """Opening a USD stage and reading what every stage states: its up axis, its
 unit, the semantic class labels on its prims; the ``ignjax:`` and semantic
-attribute names that export and import share; import warnings.
+attribute names that export and import share; import warnings, and USD's own
+diagnostics kept off stderr and turned into short ones of ours.
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import re
@@ -46,24 +48,115 @@ def warn_import(source: str, message: str) -> None:
     warnings.warn(f"{source}: {message}", UsdImportWarning, stacklevel=level)
 
 
+MAX_SEPARATE_WARNINGS = 3
+"""Up to this many USD messages of one kind are warned about one by one;
+more become one summary warning with a count and examples."""
+
+_INTERNALS = re.compile(r"pxr|\bTf|\.cpp\b|Error in '|Traceback")
+_STAGE_NOTE = re.compile(r"\s*\([^()]*\bon stage @[^@]*@ <0x[0-9a-fA-F]+>\)")
+
+
+def one_line(text) -> str:
+    """USD's message text on one line, without the trailing
+    ``(instantiating stage on stage @...@ <0x...>)`` note."""
+    return _STAGE_NOTE.sub("", " ".join(str(text).split())).strip()
+
+
+@contextlib.contextmanager
+def usd_diagnostics():
+    """Keep USD's own warnings and status messages off stderr while the block
+    runs (``Tf.DiagnosticTrap``; usd-core releases without it print them as
+    before).
+
+    Yields:
+        A list that, once the block has ended, holds the text of each
+        warning USD issued in it (one line each), for the caller to report
+        with :func:`warn_usd_messages`.
+    """
+    texts: list[str] = []
+    trap_type = getattr(Tf, "DiagnosticTrap", None)
+    if trap_type is None:
+        yield texts
+        return
+    with trap_type() as trap:
+        try:
+            yield texts
+        finally:
+            texts.extend(one_line(w.commentary) for w in trap.GetWarnings())
+            trap.Clear()
+
+
+def summarize(items: list[str], what: str, limit: int = MAX_SEPARATE_WARNINGS) -> list[str]:
+    """The items as they are when there are at most ``limit``, else one line
+    ``"<n> <what>, e.g. a; b; c; and <k> more"``."""
+    if len(items) <= limit:
+        return list(items)
+    return [f"{len(items)} {what}, e.g. {'; '.join(items[:limit])}; and {len(items) - limit} more"]
+
+
+def warn_usd_messages(source: str, messages, known=()) -> None:
+    """Warn about USD's own messages (from :func:`usd_diagnostics`) that say
+    something not already reported: those that contain none of the ``known``
+    texts (the composition errors, warned about on their own), once each,
+    in short, and as one summary line when there are many."""
+    seen = [m for m in dict.fromkeys(messages) if m and not any(k and k in m for k in known)]
+    short = [m if len(m) <= 200 else m[:197] + "..." for m in seen]
+    for line in summarize(short, "further messages from USD"):
+        warn_import(source, f"USD reported: {line}")
+
+
+def _open_reason(path: Path, error: Exception) -> str:
+    """Why USD could not open ``path``: one short line of our own (the
+    first cause USD gives, without its internals or the file's path)."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(4096)
+        if not head.strip():
+            return "empty file"
+    except OSError:
+        pass
+    causes = [getattr(a, "commentary", None) for a in getattr(error, "args", ())]
+    cause = next((one_line(c) for c in causes if c), "")
+    cause = re.sub(r"@?<[^<>]*>@?|@[^@]*@", "", cause)  # paths: the message names the file already
+    cause = re.sub(r"^is\s+", "", " ".join(cause.split()).strip(" :;,.-'"))
+    if not cause or _INTERNALS.search(cause):
+        return "not a readable USD file"
+    cause = cause[0].lower() + cause[1:]
+    if len(cause) > 100:
+        cause = cause[:97].rstrip() + "..."
+    return f"not a readable USD file ({cause})"
+
+
 def open_stage(path: str | os.PathLike):
     """Open a stage with all payloads loaded.
 
+    USD's own diagnostics are kept off stderr: its composition errors stay
+    on the stage (``GetCompositionErrors``) for the caller to report, and
+    other warnings it issues while opening become
+    :class:`UsdImportWarning` (see :func:`warn_usd_messages`).
+
     Raises:
-        SceneError: the file is missing or is not a USD file USD can open.
+        SceneError: the file is missing, empty, or not a USD file USD can
+            open; one line naming the file and the first cause USD gives,
+            without the library's internals.
     """
     p = Path(path)
     if not p.exists():
         raise SceneError(p, None, "no such file")
     if p.is_dir():
         raise SceneError(p, None, "is a directory, not a USD file")
-    try:
-        stage = Usd.Stage.Open(str(p), load=Usd.Stage.LoadAll)
-    except Tf.ErrorException as e:
-        reason = " ".join(str(e).split())
-        raise SceneError(p, None, f"not a readable USD file ({reason[:300]})") from e
+    with usd_diagnostics() as messages:
+        try:
+            stage = Usd.Stage.Open(str(p), load=Usd.Stage.LoadAll)
+        except (Tf.ErrorException, RuntimeError) as e:
+            stage, error = None, e
+        else:
+            error = None
+    if error is not None:
+        raise SceneError(p, None, _open_reason(p, error)) from None
     if stage is None:
         raise SceneError(p, None, "not a readable USD file")
+    warn_usd_messages(str(p), messages, [one_line(e) for e in stage.GetCompositionErrors()])
     return stage
 
 

@@ -13,7 +13,14 @@ from pxr import Usd, UsdGeom
 
 from ignjax.scenes import vocab
 from ignjax.scenes.io.usd.frames import TIME
-from ignjax.scenes.io.usd.naming import is_component, room_label_of, snake
+from ignjax.scenes.io.usd.naming import (
+    is_component,
+    names_object,
+    room_attribute_label,
+    room_label_of,
+    room_name_label,
+    snake,
+)
 from ignjax.scenes.io.usd.parts import authored, gprim_type, token
 from ignjax.scenes.io.usd.stage import ATTR_KIND, NS, prim_semantic_label
 
@@ -62,6 +69,7 @@ class Traversal:
     owners: list[Owner] = field(default_factory=list)
     specials: list[tuple[str, object]] = field(default_factory=list)  # ("wall" | "door", prim)
     instancers: list = field(default_factory=list)  # PointInstancer prims
+    instancer_rooms: dict = field(default_factory=dict)  # PointInstancer path -> the room Owner it lies under
     unsupported: dict[str, int] = field(default_factory=dict)  # gprim type -> count of skipped prims
 
     def new_owner(self, prim, role: str, label: str | None = None) -> Owner:
@@ -114,6 +122,12 @@ def traverse(stage) -> Traversal:
                     cat = vocab.normalize_category(label)
                     if c.label is None or c.label_cat != cat:
                         c = c._replace(label=t.new_owner(prim, "instance", label), label_cat=cat)
+                elif c.label is None and c.kind is None and c.room is None and not is_component(prim) \
+                        and not names_object(prim):
+                    # no semantic label, not part of an object or room: a room attribute, else a room name
+                    text = room_attribute_label(prim) or room_name_label(prim)
+                    if text:
+                        room = t.new_owner(prim, "room", text)
             if room is not None:
                 # A room prim is a container: its floors make the room, its
                 # other children are objects.
@@ -128,6 +142,7 @@ def traverse(stage) -> Traversal:
                         c = c._replace(root=t.new_owner(prim, "instance"))
             if prim.IsA(UsdGeom.PointInstancer):
                 t.instancers.append(prim)
+                t.instancer_rooms[p] = c.room
                 it.PruneChildren()
                 continue
             if gtype:
