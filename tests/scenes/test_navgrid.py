@@ -4,7 +4,6 @@ components, reachability, and geodesic fields against scipy's Dijkstra."""
 from __future__ import annotations
 
 import math
-import time
 
 import jax
 import jax.numpy as jnp
@@ -316,14 +315,13 @@ def test_room_without_navigable_cells(two_room_scene):
         check_reachable(scene, grid)
 
 
-def test_ten_room_house_builds_fast():
+def test_ten_room_house_builds():
+    """A 10-room house compiles, gets a grid and every room is reachable
+    (no time limit is asserted: ``python -m ignjax.bench`` times this house's
+    compile and grids as ``scene_compile_s``)."""
     scene = generate_house(3, HouseParams(n_rooms=10))
-    t0 = time.perf_counter()
     compiled = compile_scene(scene)
     grid = build_navgrid(compiled)
-    elapsed = time.perf_counter() - t0
-    print(f"10-room house: {compiled.ngeom} geoms, grid {grid.shape} x {grid.n_slices}: compile + grid {elapsed:.2f} s")
-    assert elapsed < 10.0
     check_reachable(scene, grid)
 
 

@@ -9,7 +9,6 @@ import math
 import os
 import subprocess
 import sys
-import time
 from types import MappingProxyType
 
 import numpy as np
@@ -570,8 +569,9 @@ def test_inventory_of_typical_houses_shipped_catalogue():
         assert len(h.objects) >= 20 and len(counts) >= 10 and max(counts.values()) >= 2, (h.id, counts)
 
 
-def test_twelve_room_house_is_fast():
-    generate_house(0, HouseParams(n_rooms=12))  # warm caches
-    t = time.perf_counter()
-    generate_house(123, HouseParams(n_rooms=12), catalogue=WIDE)
-    assert time.perf_counter() - t < 1.0
+def test_twelve_room_house_generates():
+    """A 12-room house of the wide catalogue is generated with all its rooms and
+    furnished (no time limit is asserted: timings belong to the bench, not the tests)."""
+    h = generate_house(123, HouseParams(n_rooms=12), catalogue=WIDE)
+    assert len(h.rooms) == 12
+    assert len(h.objects) >= 20

@@ -1,0 +1,100 @@
+"""``python -m ignjax.bench --json``: the last stdout line is one JSON object
+with every figure the module docstring lists.
+
+Its smallest run (``--quick``) still times rollouts at B = 256, 1024 and
+4096 and the in-the-loop sweep over 500 episodes, many minutes on a small
+CPU, so the command itself runs only in the optional ``slow`` tests
+(``pytest -m slow``). The default run checks the record's parts that the
+bench's library functions make in seconds: the probe-ray agreement
+(:func:`ignjax.bench.rays.bench_probe_rays`) and the decision-steps table
+(:func:`ignjax.bench.rollouts.bench_steps`, at the test benchmark's size).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+
+import pytest
+
+from ignjax.bench.rays import bench_probe_rays
+from ignjax.bench.rollouts import bench_steps
+
+RAY_KEYS = {"fast", "mjx", "mj_multiray", "rollout_depth_march"}
+PROBE_KEYS = {"collision", "collision_2m", "observation"}
+STUDY_KEYS = {"offline_wsr_1e6_x_500_s", "in_loop_vectors", "in_loop_episodes", "in_loop_s", "in_loop_run_s",
+              "in_loop_episodes_per_s"}
+TOP_KEYS = {"device", "quick", "n_rays", "ngeom", "rays_per_s", "ray_agreement", "ray_agreement_depth_march",
+            "scene_compile_s", "speedup_vs_mjx", "speedup_vs_multiray", "probe_ray_agreement", "rollout_parts",
+            "steps_per_s", "compile_s", "studies"}
+SIZES = ("256", "1024", "4096")
+
+
+def _positive(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v > 0
+
+
+def _fraction(v) -> bool:
+    return isinstance(v, float) and 0.0 <= v <= 1.0
+
+
+def check_probe_agreement(rec: dict) -> None:
+    assert set(rec) == PROBE_KEYS
+    assert all(_fraction(v) for v in rec.values()), rec
+    assert rec["collision"] >= 0.99 and rec["collision_2m"] >= 0.98 and rec["observation"] >= 0.9, rec
+
+
+def check_steps(rec: dict, agents, sizes) -> None:
+    assert set(rec) == set(agents)
+    for name in agents:
+        assert set(rec[name]) == set(sizes), rec[name]
+        assert all(_positive(v) for v in rec[name].values()), rec[name]
+
+
+def check_record(res: dict) -> None:
+    """Every documented figure of the bench's JSON object, with sane types."""
+    assert TOP_KEYS <= set(res), sorted(TOP_KEYS - set(res))
+    assert isinstance(res["device"], str) and res["device"]
+    assert res["quick"] is True
+    assert isinstance(res["n_rays"], int) and res["n_rays"] > 0 and isinstance(res["ngeom"], int) and res["ngeom"] > 0
+    assert set(res["rays_per_s"]) == RAY_KEYS and all(_positive(v) for v in res["rays_per_s"].values())
+    assert _fraction(res["ray_agreement"]) and res["ray_agreement"] >= 0.99
+    assert _fraction(res["ray_agreement_depth_march"]) and res["ray_agreement_depth_march"] >= 0.99
+    for k in ("scene_compile_s", "speedup_vs_mjx", "speedup_vs_multiray"):
+        assert _positive(res[k]), k
+    check_probe_agreement(res["probe_ray_agreement"])
+    assert set(res["rollout_parts"]) == set(SIZES)
+    assert all(isinstance(v, int) and v >= 1 for v in res["rollout_parts"].values())
+    check_steps(res["steps_per_s"], ("random", "eig"), SIZES)  # --quick: the EIG and random agents only
+    assert isinstance(res["compile_s"], float) and math.isfinite(res["compile_s"])
+    s = res["studies"]
+    assert set(s) == STUDY_KEYS
+    assert s["in_loop_vectors"] == 16 and s["in_loop_episodes"] == 500  # --quick: K = 16
+    assert all(_positive(v) for v in s.values()), s
+
+
+def test_probe_ray_agreement_figures():
+    check_probe_agreement(bench_probe_rays(quick=True))
+
+
+def test_decision_steps_figures(small_benchmark, small_world):
+    es = small_benchmark["set"]
+    steps, compile_s = bench_steps(es, small_world, ("random",), (len(es),))
+    check_steps(steps, ("random",), (str(len(es)),))
+    assert math.isnan(compile_s)  # measured for the EIG agent only
+    assert json.loads(json.dumps(steps)) == steps  # plain JSON values
+
+
+@pytest.mark.slow
+def test_quick_json_line():
+    """``python -m ignjax.bench --quick --json`` (many minutes): the last stdout line parses as the full record."""
+    proc = subprocess.run([sys.executable, "-m", "ignjax.bench", "--quick", "--json"], capture_output=True, text=True,
+                          timeout=3600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    lines = proc.stdout.strip().splitlines()
+    assert lines, proc.stderr[-2000:]
+    res = json.loads(lines[-1])
+    assert isinstance(res, dict)
+    check_record(res)

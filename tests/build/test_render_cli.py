@@ -1,0 +1,94 @@
+"""``python -m ignjax.build render`` run as a user runs it (a subprocess) on a
+small scene written to a temporary folder: it writes the top-down map, the
+front view (``--size`` pixels square) and the 3 x 3 panorama panel (three
+views a side), and none of them is blank.
+
+Rendering needs headless OpenGL: the test uses the first of
+``$MUJOCO_GL`` (default ``egl``) and ``osmesa`` that can open a MuJoCo
+renderer here, and is skipped, naming each backend's error, when none can.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import matplotlib.image as mpimg
+import numpy as np
+import pytest
+
+from ignjax.scenes.io.usd import save_usd
+
+SIZE = 48
+
+_PROBE = ("import mujoco\n"
+          "m = mujoco.MjModel.from_xml_string(\"<mujoco><worldbody><geom size='1 1 .1' type='plane'/></worldbody></mujoco>\")\n"
+          "r = mujoco.Renderer(m, 16, 16)\n"
+          "r.close()\n")
+
+
+def _gl_env(backend: str) -> dict:
+    env = dict(os.environ, MUJOCO_GL=backend)
+    env["PYOPENGL_PLATFORM"] = "osmesa" if backend == "osmesa" else "egl"
+    return env
+
+
+@pytest.fixture(scope="module")
+def gl_env() -> dict:
+    """The environment of the first headless OpenGL backend that renders here (or a skip naming why none does)."""
+    errors = []
+    for backend in dict.fromkeys((os.environ.get("MUJOCO_GL", "egl"), "egl", "osmesa")):
+        env = _gl_env(backend)
+        proc = subprocess.run([sys.executable, "-c", _PROBE], env=env, capture_output=True, text=True, timeout=120)
+        if proc.returncode == 0:
+            return env
+        last = (proc.stderr.strip().splitlines() or ["no error output"])[-1]
+        errors.append(f"MUJOCO_GL={backend}: {last}")
+    pytest.skip("no headless OpenGL backend can render here (" + "; ".join(errors) + ")")
+
+
+@pytest.fixture(scope="module")
+def rendered(two_room_scene, gl_env, tmp_path_factory):
+    root = tmp_path_factory.mktemp("render")
+    src = root / "two_rooms.usda"
+    save_usd(two_room_scene, src)
+    out = root / "out"
+    proc = subprocess.run([sys.executable, "-m", "ignjax.build", "render", str(src), "--out", str(out), "--size", str(SIZE)],
+                          env=gl_env, capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    return out, two_room_scene.id, proc.stdout
+
+
+def _image(path) -> np.ndarray:
+    img = mpimg.imread(path)
+    assert img.ndim == 3 and img.shape[2] in (3, 4)
+    return img[..., :3].astype(np.float64)
+
+
+def test_render_writes_the_promised_images(rendered):
+    out, sid, stdout = rendered
+    names = {f"{sid}_map.png", f"{sid}_front.png", f"{sid}_panorama.png"}
+    assert {p.name for p in out.iterdir()} == names  # nothing else (no temporary files left behind)
+    for name in names:
+        assert name in stdout
+    assert _image(out / f"{sid}_front.png").shape == (SIZE, SIZE, 3)
+    assert _image(out / f"{sid}_panorama.png").shape == (3 * SIZE, 3 * SIZE, 3)
+    assert min(_image(out / f"{sid}_map.png").shape[:2]) >= 100
+
+
+def test_rendered_images_are_not_blank(rendered):
+    out, sid, _ = rendered
+    for name in ("map", "front", "panorama"):
+        img = _image(out / f"{sid}_{name}.png")
+        assert img.var() > 1e-4, name
+    # each of the panel's eight views shows something (the centre tile is the blank filler)
+    panel = _image(out / f"{sid}_panorama.png")
+    tiles = {(i, j): panel[i * SIZE:(i + 1) * SIZE, j * SIZE:(j + 1) * SIZE] for i in range(3) for j in range(3)}
+    for (i, j), tile in tiles.items():
+        if (i, j) == (1, 1):
+            assert np.all(tile == 1.0)
+        else:
+            assert tile.var() > 1e-4, (i, j)
+    # the front view is the panel's top-middle tile
+    np.testing.assert_allclose(tiles[(0, 1)], _image(out / f"{sid}_front.png"), atol=1 / 255)
