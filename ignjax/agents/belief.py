@@ -11,9 +11,13 @@ log-likelihood of the answers received so far.
 
 Answer models (likelihood of answer a under hypothesis h):
 
-* Type 1: a = the target's colour. A seen candidate answers its observed
-  colour (uniform when unobserved); "not seen" answers uniformly over
-  the 12 colours. Once the answer is known the question is worth 0.
+* Type 1: a = the target's attributes (colour, material, size, state). A
+  seen candidate answers the attributes it was seen with (uniformly when
+  none was observed); "not seen" answers uniformly over the
+  ``N_ATTR_ANSWERS`` combinations. Folding a received answer: each said
+  attribute a candidate was seen with another value of costs it
+  ``ATTR_MISMATCH_LOGLIK``; "not seen" pays ``-log(n)`` per said attribute
+  with n values. Once the answer is known the question is worth 0.
 * Type 2: a = the goal room label (12 labels). A candidate answers the
   room label the agent stood in when it saw it (uniform when unknown);
   "not seen" answers uniformly. Worth 0 once known.
@@ -23,6 +27,10 @@ Answer models (likelihood of answer a under hypothesis h):
 * Type 4: about the most probable candidate in the front view within
   ``CONFIRM_RANGE`` (3 m): yes under that candidate, no under every other
   hypothesis. Worth 0 when no candidate is in front.
+* The active route hint's progress report after a MOVE (with
+  ``BeliefParams.hint_stop``): a MOVE that ends within ``HINT_REJECT_RANGE``
+  of a candidate's estimated centre without the report "stop eligible"
+  (the target within the stop radius) rejects that candidate.
 
 EIG_t = H[b] - sum_a p(a) H[b | a] (nats) for each type, exactly on the
 belief (:func:`question_eigs`; :func:`expected_information_gain` is the
@@ -37,13 +45,23 @@ import math
 import jax
 import jax.numpy as jnp
 
-from ignjax.agents.memory import N_ROOM_LABELS, Memory, candidate_relative, observe_memory
+from ignjax.agents.memory import (
+    N_ROOM_LABELS, ROOM_MISMATCH_LOGLIK, Memory, attribute_loglik, candidate_relative, observe_memory,
+)
 from ignjax.arrays import pytree_dataclass
 from ignjax.protocol import CONFIRM_RANGE, LOCKED_COSTS
 from ignjax.scenes import vocab
 from ignjax.sim import types as T
 
 N_COLORS = len(vocab.COLORS)
+ATTR_VALUES = (len(vocab.COLORS), len(vocab.MATERIALS), len(vocab.SIZES), len(vocab.STATES))
+N_ATTR_ANSWERS = math.prod(ATTR_VALUES)  # Type-1 answers: every (colour, material, size, state)
+HINT_REJECT_RANGE = 0.8  # m: a MOVE ending this close to a candidate without "stop eligible" rejects it
+
+
+def said_attributes(answers: T.Answer):
+    """(4,) int32 attribute codes the Type-1 answer says (colour, material, size, state; -1 unsaid)."""
+    return jnp.stack([answers.color, answers.material, answers.size, answers.state]).astype(jnp.int32)
 
 
 @pytree_dataclass
@@ -69,7 +87,24 @@ class BeliefParams:
             not in it and has seen no candidate there.
         recovery_steps: () safeguard 4: after this many decisions without a
             committed candidate and without any Type-3 answer, ask Type 3
-            (0: off).
+            when its EIG / cost exceeds ``recovery_ratio`` x ``threshold``,
+            in a passage (0: off).
+        recovery_ratio: () safeguard 4's share of the asking threshold (it
+            lowers the bar, so recovery still asks less as costs rise).
+        recovery_wait: () safeguard 4 inside a closed room: decisions it
+            waits for a passage before asking there anyway.
+        cache_facts: () bool, safeguard 1: Type 1 and Type 2 only while the
+            fact is missing (cached once answered). false: they stay on
+            offer at their Eq. (1) value.
+        follow_up: () bool, safeguard 3: after a yes to Type 4, STOP at once
+            ("stop now") or exactly one MOVE toward the confirmed candidate
+            and then STOP, with no question in between.
+        hint_stop: () bool, an active route hint's report "stop eligible"
+            (the target within the stop radius after a MOVE) stops the
+            agent, and a MOVE that ends next to a candidate without that
+            report rejects the candidate (the paper's stop policy).
+        hint_follow: () weight of the active route hint's heading when
+            exploring, until the hinted point is reached (0: off).
     """
 
     costs: jax.Array
@@ -81,13 +116,21 @@ class BeliefParams:
     decision_eig: jax.Array
     type3_gate: jax.Array
     recovery_steps: jax.Array
+    recovery_ratio: jax.Array
+    recovery_wait: jax.Array
+    cache_facts: jax.Array
+    follow_up: jax.Array
+    hint_stop: jax.Array
+    hint_follow: jax.Array
 
 
 def default_belief_params(**kw) -> BeliefParams:
     base = dict(costs=jnp.asarray(LOCKED_COSTS, jnp.float32), threshold=jnp.float32(2.5), commit=jnp.float32(0.5),
                 p_stop=jnp.float32(0.8), stop_range=jnp.float32(1.0), prior_count=jnp.float32(3.0),
                 decision_eig=jnp.array(True), type3_gate=jnp.array(True),
-                recovery_steps=jnp.float32(6.0))
+                recovery_steps=jnp.float32(6.0), recovery_ratio=jnp.float32(0.5),
+                recovery_wait=jnp.float32(6.0), cache_facts=jnp.array(True),
+                follow_up=jnp.array(True), hint_stop=jnp.array(True), hint_follow=jnp.float32(2.0))
     base.update({k: jnp.asarray(v, base[k].dtype if k in base else jnp.float32) for k, v in kw.items()})
     return BeliefParams(**base)
 
@@ -104,10 +147,11 @@ def _sector_likelihood(answer, sectors):
     return jnp.where(diff == 0, 0.6, jnp.where(diff == 1, 0.2, 1e-3))
 
 
-def _fold_answers(mem: Memory, obs: T.Observation, answers: T.Answer) -> Memory:
+def _fold_answers(mem: Memory, obs: T.Observation, answers: T.Answer, hint_stop=False) -> Memory:
     """Fold the answers into the belief: the Type-1 and Type-2 facts once,
     when they first become known (asked, or given at reset with the upfront
-    description); the answer to last step's Type-3 or Type-4 question."""
+    description); the answer to last step's Type-3 or Type-4 question; with
+    ``hint_stop``, the active hint's progress report after last step's MOVE."""
     q = mem.last_asked
     fresh = (q > 0) & ~answers.refused & (answers.last_type == q)
     new1 = answers.known[0] & ~mem.consumed[0]
@@ -115,13 +159,13 @@ def _fold_answers(mem: Memory, obs: T.Observation, answers: T.Answer) -> Memory:
     M = mem.handle.shape[0]
     labels = jnp.arange(N_ROOM_LABELS)[:, None]
     rel = _abs_sector(obs)[None, :]
-    # Type 1: colour
-    colour_bad = (mem.attrs[:, 0] >= 0) & (mem.attrs[:, 0] != answers.color) & (answers.color >= 0)
-    d1 = jnp.where(colour_bad, -8.0, 0.0)
-    u1 = jnp.full((N_ROOM_LABELS, 8), jnp.where(answers.color >= 0, -math.log(N_COLORS), 0.0))
+    # Type 1: attributes
+    said = said_attributes(answers)
+    d1 = attribute_loglik(mem.attrs, said)
+    u1 = jnp.full((N_ROOM_LABELS, 8), -jnp.sum(jnp.where(said >= 0, jnp.log(jnp.asarray(ATTR_VALUES, jnp.float32)), 0.0)))
     # Type 2: room label
     room_bad = (mem.room >= 0) & (mem.room != answers.room_label) & (answers.room_label >= 0)
-    d2 = jnp.where(room_bad, -4.0, 0.0)
+    d2 = jnp.where(room_bad, ROOM_MISMATCH_LOGLIK, 0.0)
     u2 = jnp.where((answers.room_label >= 0) & (labels != answers.room_label), -30.0, 0.0) * jnp.ones((1, 8))
     # Type 3: route sector (relative at asking time = now)
     _, bearing = candidate_relative(mem, obs)
@@ -135,6 +179,10 @@ def _fold_answers(mem: Memory, obs: T.Observation, answers: T.Answer) -> Memory:
     d4 = jnp.where(yes, jnp.where(onehot, 0.0, -jnp.inf), 0.0)
     rej4 = jnp.where(~yes & (slot >= 0), onehot, False)
     u4 = jnp.where(yes, -jnp.inf, 0.0) * jnp.ones((N_ROOM_LABELS, 8))
+    # the active hint's progress after last step's MOVE: a candidate reached without "stop eligible" is not the target
+    dist, _ = candidate_relative(mem, obs)
+    moved = (q == 0) & (mem.t > 0) & answers.hint_active & (answers.hint_progress != T.HINT_NONE)
+    rej_hint = hint_stop & moved & (answers.hint_progress != T.HINT_STOP) & (mem.handle >= 0) & (dist <= HINT_REJECT_RANGE)
     f3, f4 = fresh & (q == 3), fresh & (q == 4)
     d = jnp.where(new1, d1, 0.0) + jnp.where(new2, d2, 0.0) + jnp.where(f3, d3, 0.0) + jnp.where(f4, d4, 0.0)
     u = jnp.where(new1, u1, 0.0) + jnp.where(new2, u2, 0.0) + jnp.where(f3, u3, 0.0) + jnp.where(f4, u4, 0.0)
@@ -142,9 +190,10 @@ def _fold_answers(mem: Memory, obs: T.Observation, answers: T.Answer) -> Memory:
         mem,
         logw=mem.logw + d,
         unseen_logw=mem.unseen_logw + u,
-        rejected=mem.rejected | (f4 & rej4),
+        rejected=mem.rejected | (f4 & rej4) | rej_hint,
         hint_heading=jnp.where(f3, obs.heading + answers.hint_sector.astype(jnp.float32) * (math.pi / 4), mem.hint_heading),
         has_hint=mem.has_hint | f3,
+        hint_done=(mem.hint_done | (answers.hint_progress == T.HINT_REACHED)) & ~f3,
         consumed=mem.consumed | jnp.stack([new1, new2, f3, f4]),
     )
 
@@ -175,8 +224,26 @@ def expected_information_gain(b, L):
     return _entropy(b) - jnp.sum(pa * _entropy(post, axis=1))
 
 
-def question_eigs(mem: Memory, obs: T.Observation, answers: T.Answer, b):
+def _attribute_eig(attrs, bc, unseen):
+    """EIG of the Type-1 question: I(hypothesis; answer) = H[p(a)] - u log N
+    with u the mass answering uniformly over the N = ``N_ATTR_ANSWERS``
+    combinations; the N - G answers no candidate gives share u / N each."""
+    M = attrs.shape[0]
+    known = jnp.any(attrs >= 0, axis=1)
+    same = jnp.all(attrs[:, None] == attrs[None], axis=-1) & known[:, None] & known[None]  # Shape: (M, M)
+    first = known & ~jnp.any(same & (jnp.arange(M)[None] < jnp.arange(M)[:, None]), axis=1)
+    u = unseen + jnp.sum(jnp.where(known, 0.0, bc))
+    pa = jnp.where(first, same.astype(bc.dtype) @ bc + u / N_ATTR_ANSWERS, 0.0)  # Shape: (M,) one answer per group
+    n_other = N_ATTR_ANSWERS - jnp.sum(first)
+    p_other = u / N_ATTR_ANSWERS
+    h_other = jnp.where(p_other > 0, -n_other * p_other * jnp.log(jnp.where(p_other > 0, p_other, 1.0)), 0.0)
+    return _entropy(pa) + h_other - u * math.log(N_ATTR_ANSWERS)
+
+
+def question_eigs(mem: Memory, obs: T.Observation, answers: T.Answer, b, cached=True):
     """(4,) EIG of each question type on belief ``b``; also the Type-4 slot.
+    With ``cached`` (safeguard 1) a Type-1 or Type-2 fact already received
+    is worth 0; without it the answer model values it as if unknown.
 
     Eq. (1) through the mutual-information identity
     H[b] - E_a H[b | a] = H[p(a)] - sum_h b_h H[p(a | h)], on the structure
@@ -185,11 +252,9 @@ def question_eigs(mem: Memory, obs: T.Observation, answers: T.Answer, b):
     M = mem.handle.shape[0]
     valid = (mem.handle >= 0) & ~mem.rejected
     bc, bu = b[:M], b[M:].reshape(N_ROOM_LABELS, 8)  # Shape: (M,), (L, 8)
-    # Type 1: colour; candidates of unobserved colour and unseen hypotheses answer uniformly
-    col = mem.attrs[:, 0]
-    uniform1 = jnp.sum(jnp.where(col < 0, bc, 0.0)) + jnp.sum(bu)
-    pa1 = jnp.sum(jnp.where(jnp.arange(N_COLORS)[:, None] == col[None], bc[None], 0.0), axis=1) + uniform1 / N_COLORS
-    e1 = _entropy(pa1) - uniform1 * math.log(N_COLORS)
+    # Type 1: attributes; a candidate answers the combination it was seen with (one answer per distinct
+    # combination, the first slot holding it), candidates seen with none and unseen hypotheses answer uniformly
+    e1 = _attribute_eig(mem.attrs, bc, jnp.sum(bu))
     # Type 2: room label; an unseen hypothesis answers its own label
     uniform2 = jnp.sum(jnp.where(mem.room < 0, bc, 0.0))
     pa2 = jnp.sum(jnp.where(jnp.arange(N_ROOM_LABELS)[:, None] == mem.room[None], bc[None], 0.0), axis=1) \
@@ -211,11 +276,12 @@ def question_eigs(mem: Memory, obs: T.Observation, answers: T.Answer, b):
     has = jnp.any(in_front)
     e4 = _entropy(jnp.stack([bc[slot], jnp.sum(b) - bc[slot]]))
     e = jnp.stack([e1, e2, e3, e4])
-    e = e * jnp.stack([~answers.known[0], ~answers.known[1], jnp.array(True), has])
+    cached = jnp.asarray(cached)
+    e = e * jnp.stack([~(answers.known[0] & cached), ~(answers.known[1] & cached), jnp.array(True), has])
     return jnp.maximum(e, 0.0), jnp.where(has, slot, -1)
 
 
-def decision_eigs(mem: Memory, obs: T.Observation, answers: T.Answer, b):
+def decision_eigs(mem: Memory, obs: T.Observation, answers: T.Answer, b, cached=True):
     """:func:`question_eigs` on the decision's partition of the belief: the
     "not seen yet" hypotheses of one direction sector count as one (the agent
     cannot act on the room label of an instance it has not seen), so Type 2
@@ -223,12 +289,12 @@ def decision_eigs(mem: Memory, obs: T.Observation, answers: T.Answer, b):
     ``sum_s B_s H[label | unseen, s]`` with ``B_s`` the unseen mass of
     sector s. Types 1, 3 and 4 answer alike under every unseen hypothesis of
     a sector, so their EIG does not change."""
-    e, slot = question_eigs(mem, obs, answers, b)
+    e, slot = question_eigs(mem, obs, answers, b, cached)
     M = mem.handle.shape[0]
     bu = b[M:].reshape(N_ROOM_LABELS, 8)
     mass = jnp.sum(bu, axis=0)  # Shape: (8,)
     within = jnp.sum(mass * _entropy((bu / jnp.maximum(mass, 1e-12)[None]).T, axis=1))
-    e = e.at[1].set(jnp.where(answers.known[1], 0.0, jnp.maximum(e[1] - within, 0.0)))
+    e = e.at[1].set(jnp.maximum(e[1] - within, 0.0))
     return e, slot
 
 
@@ -249,11 +315,12 @@ def update_belief(params: BeliefParams, obs: T.Observation, answers: T.Answer, m
     Returns:
         (memory, belief): the updated memory and :func:`belief` on it.
     """
-    mem = _fold_answers(mem, obs, answers)
-    mem = observe_memory(mem, obs, jnp.where(answers.known[0], answers.color, -1),
+    mem = _fold_answers(mem, obs, answers, params.hint_stop)
+    mem = observe_memory(mem, obs, jnp.where(answers.known[0], said_attributes(answers), -1),
                          jnp.where(answers.known[1], answers.room_label, -1))
     return mem, belief(mem, params)
 
 
-__all__ = ["BeliefParams", "N_COLORS", "belief", "decision_eigs", "default_belief_params", "expected_information_gain",
-           "question_eigs", "unseen_direction", "update_belief"]
+__all__ = ["ATTR_VALUES", "BeliefParams", "HINT_REJECT_RANGE", "N_ATTR_ANSWERS", "N_COLORS", "belief", "decision_eigs",
+           "default_belief_params", "expected_information_gain", "question_eigs", "said_attributes", "unseen_direction",
+           "update_belief"]

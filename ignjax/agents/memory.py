@@ -29,6 +29,8 @@ VISIT_CELL = 0.5
 VISIT_SIZE = 64
 VISIT_DTYPE = jnp.uint8  # visit counts saturate at 255; a cell is counted once per decision
 MAX_CANDIDATES = 12
+ATTR_MISMATCH_LOGLIK = -8.0  # log-likelihood of a Type-1 answer per said attribute a candidate was seen without
+ROOM_MISMATCH_LOGLIK = -4.0  # log-likelihood of a Type-2 answer under a candidate seen in a room of another label
 
 
 @pytree_dataclass
@@ -51,6 +53,7 @@ class Memory:
             (45 degree sectors of world heading) from the agent".
         hint_heading: () float32 absolute heading of the last Type-3 hint.
         has_hint: () bool.
+        hint_done: () bool, the active hint's point was reached (reset by a new hint).
         last_asked: () int32 question type asked at the previous step (0 none).
         asked_about: () int32 slot a pending Type-4 question was about (-1).
         approach: () int32 slot being approached (-1).
@@ -71,6 +74,7 @@ class Memory:
     unseen_logw: jax.Array
     hint_heading: jax.Array
     has_hint: jax.Array
+    hint_done: jax.Array
     last_asked: jax.Array
     asked_about: jax.Array
     approach: jax.Array
@@ -85,7 +89,8 @@ class Memory:
                       pos=jnp.zeros((M, 2), jnp.float32), attrs=jnp.full((M, 4), -1, jnp.int32),
                       room=jnp.full(M, -1, jnp.int32), logw=jnp.zeros(M, jnp.float32), rejected=jnp.zeros(M, bool),
                       unseen_logw=jnp.zeros((N_ROOM_LABELS, 8), jnp.float32), hint_heading=jnp.float32(0.0),
-                      has_hint=jnp.array(False), last_asked=jnp.int32(0), asked_about=jnp.int32(-1),
+                      has_hint=jnp.array(False), hint_done=jnp.array(False), last_asked=jnp.int32(0),
+                      asked_about=jnp.int32(-1),
                       approach=jnp.int32(-1), pending_stop=jnp.array(False), t=jnp.int32(0),
                       consumed=jnp.zeros(4, bool))
 
@@ -96,15 +101,26 @@ def visit_index(xy):
     return jnp.clip(ij, 0, VISIT_SIZE - 1)
 
 
-def observe_memory(mem: Memory, obs: T.Observation, colour_known=None, room_known=None) -> Memory:
+def attribute_loglik(attrs, said):
+    """(...) log-likelihood of a Type-1 answer that says attributes ``said``
+    (4,) int32 (colour, material, size, state; -1 unsaid) under "the
+    candidate with observed ``attrs`` (..., 4) is the target":
+    :data:`ATTR_MISMATCH_LOGLIK` per said attribute the candidate was seen
+    with another value of (unobserved attributes agree with anything)."""
+    bad = (attrs >= 0) & (said >= 0) & (attrs != said)
+    return ATTR_MISMATCH_LOGLIK * jnp.sum(bad, axis=-1).astype(jnp.float32)
+
+
+def observe_memory(mem: Memory, obs: T.Observation, attrs_known=None, room_known=None) -> Memory:
     """Fold an observation into memory: mark the visit, add/refresh the
     candidates of the goal category in sight. New candidates start with
-    the log-likelihood of the Type-1 colour and Type-2 room answers already
-    received (``colour_known`` / ``room_known``: () int32 codes or -1)."""
+    the log-likelihood of the Type-1 attributes and Type-2 room answers
+    already received (``attrs_known``: (4,) int32 said colour, material,
+    size and state codes, -1 unsaid; ``room_known``: () int32 code or -1)."""
     ij = visit_index(obs.odometry[:2])
     v = mem.visits[ij[1], ij[0]]
     visits = mem.visits.at[ij[1], ij[0]].set(jnp.where(v < jnp.iinfo(v.dtype).max, v + 1, v))
-    colour_known = jnp.int32(-1) if colour_known is None else colour_known
+    attrs_known = jnp.full(4, -1, jnp.int32) if attrs_known is None else jnp.asarray(attrs_known, jnp.int32)
     room_known = jnp.int32(-1) if room_known is None else room_known
 
     def add(k, m: Memory):
@@ -120,9 +136,8 @@ def observe_memory(mem: Memory, obs: T.Observation, colour_known=None, room_know
         can = ok & (exists | jnp.any(free))
         new = ok & ~exists & jnp.any(free)
         room = jnp.where(obs.visible_range[k] <= 3.0, obs.room_label, -1)
-        colour = obs.visible_attrs[k, 0]
-        lw = jnp.where((colour_known >= 0) & (colour >= 0) & (colour != colour_known), -8.0, 0.0) \
-            + jnp.where((room_known >= 0) & (room >= 0) & (room != room_known), -4.0, 0.0)
+        lw = attribute_loglik(obs.visible_attrs[k], attrs_known) \
+            + jnp.where((room_known >= 0) & (room >= 0) & (room != room_known), ROOM_MISMATCH_LOGLIK, 0.0)
         return dataclasses.replace(
             m,
             handle=m.handle.at[slot].set(jnp.where(can, h, m.handle[slot])),
@@ -144,5 +159,5 @@ def candidate_relative(mem: Memory, obs: T.Observation):
     return dist, bearing
 
 
-__all__ = ["MAX_CANDIDATES", "Memory", "N_ROOM_LABELS", "VISIT_CELL", "VISIT_DTYPE", "VISIT_SIZE", "candidate_relative",
-           "observe_memory", "visit_index"]
+__all__ = ["ATTR_MISMATCH_LOGLIK", "MAX_CANDIDATES", "Memory", "N_ROOM_LABELS", "ROOM_MISMATCH_LOGLIK", "VISIT_CELL",
+           "VISIT_DTYPE", "VISIT_SIZE", "attribute_loglik", "candidate_relative", "observe_memory", "visit_index"]

@@ -25,11 +25,24 @@ The belief-based agents (explorer, naive asker, EIG agent) keep a
 :class:`~ignjax.agents.memory.Memory` and the belief of
 :mod:`ignjax.agents.belief` (hypotheses, answer models, EIG per question
 type). The EIG agent asks the type maximising EIG_t / w_t if that ratio
-exceeds ``threshold`` and questions are left. Otherwise a belief agent
-moves: to the most probable candidate when its posterior exceeds ``commit``
-(stopping there when closer than ``stop_range`` with posterior at least
-``p_stop``), else it explores, biased toward the belief's unseen mass
-(where route hints point; the explorer is not biased). In the last
+exceeds ``threshold`` and questions are left, with the paper's four
+controller safeguards, each a parameter that can be switched off: Type 1
+and 2 only while the fact is missing (``cache_facts``); Type 3 only where
+space is uncertain (``type3_gate``, :func:`spatial_uncertainty`: branches
+and corridors of passages, loops, a known goal room whose entry is not
+seen); the Type-4 follow-up (``follow_up``); recovery, a Type-3 question
+after ``recovery_steps`` decisions without a plausible candidate or any
+route answer, at a lower bar (``recovery_ratio``) so that it too fades as
+costs rise, in a passage or after ``recovery_wait`` more decisions. Its
+EIG is taken on the decision's partition of the belief (``decision_eig``).
+Otherwise a belief agent moves: to the most probable candidate when its
+posterior exceeds ``commit`` (stopping there when closer than
+``stop_range`` with posterior at least ``p_stop``), else it explores,
+biased toward the belief's unseen mass and, until its point is reached,
+toward the active route hint (``hint_follow``; the explorer is not
+biased). An active route hint reporting "stop eligible" after a MOVE
+stops the asking agents, and one that does not rejects a candidate the
+MOVE ended next to (``hint_stop``; the paper's stop policy). In the last
 ``DEADLINE_STEPS`` planner steps every belief agent heads for its most
 probable seen candidate and stops there, and its final step is always a
 STOP (needed when success requires one, ``require_stop``). After a
@@ -53,6 +66,7 @@ from ignjax.agents.belief import (
 from ignjax.agents.memory import N_ROOM_LABELS, Memory, candidate_relative, observe_memory, visit_index
 from ignjax.agents.motion import explore_direction, move_toward
 from ignjax.arrays import pytree_dataclass
+from ignjax.scenes import vocab
 from ignjax.sim import types as T
 
 DEADLINE_STEPS = 4  # belief agents commit to their best seen candidate this many steps before the end
@@ -113,8 +127,13 @@ SHORTEST_PATH = Agent("shortest_path", _random_init, _path_act, lambda: PathPara
 # ---------------------------------------------------------------------------
 
 
-def _move_policy(mem: Memory, obs: T.Observation, params: BeliefParams, b, key, hint_weight):
-    """MOVE or STOP from the belief (shared by the belief-based agents)."""
+def _move_policy(mem: Memory, obs: T.Observation, answers: T.Answer, params: BeliefParams, b, key, hint_weight):
+    """MOVE or STOP from the belief (shared by the belief-based agents).
+
+    ``hint_weight`` biases exploration toward the belief's unseen mass;
+    with an active route hint not yet reached, exploration also leans
+    toward the hint's heading (``params.hint_follow``), and the hint's
+    report "stop eligible" stops the agent (``params.hint_stop``)."""
     M = mem.handle.shape[0]
     dist, bearing = candidate_relative(mem, obs)
     bc = b[:M]
@@ -126,10 +145,16 @@ def _move_policy(mem: Memory, obs: T.Observation, params: BeliefParams, b, key, 
     committed = (bc[j] >= params.commit) | late
     close = dist[j] <= params.stop_range
     stuck = (obs.last_move < 0.05) & (mem.t > 0) & (dist[j] <= params.stop_range + 0.8)  # furniture in the way
-    stop = (committed & (close | stuck) & ((bc[j] >= params.p_stop) | late)) | (obs.steps_left <= 1)
+    eligible = params.hint_stop & answers.hint_active & (answers.hint_progress == T.HINT_STOP)
+    stop = (committed & (close | stuck) & ((bc[j] >= params.p_stop) | late)) | (obs.steps_left <= 1) | eligible
     approach = move_toward(bearing[j], jnp.clip(dist[j] - 0.5, 0.5, 2.5))
     head, conc = unseen_direction(mem, b)
-    rel, free = explore_direction(mem, obs, bias=head, bias_weight=hint_weight * conc, rng=key)
+    # Shape: () the bias heading: the belief's unseen mass, and the route hint's heading while it is followed
+    following = (hint_weight > 0) & mem.has_hint & ~mem.hint_done
+    w_unseen, w_hint = hint_weight * conc, jnp.where(following, params.hint_follow, 0.0)
+    bx = w_unseen * jnp.cos(head) + w_hint * jnp.cos(mem.hint_heading)
+    by = w_unseen * jnp.sin(head) + w_hint * jnp.sin(mem.hint_heading)
+    rel, free = explore_direction(mem, obs, bias=jnp.arctan2(by, bx), bias_weight=jnp.hypot(bx, by), rng=key)
     explore = move_toward(rel, jnp.clip(free - 0.4, 0.8, 2.5))
     move = jax.tree.map(lambda a, e: jnp.where(committed, a, e), approach, explore)
     act = jax.tree.map(lambda s, m: jnp.where(stop, s, m), T.Action.make(T.STOP), move)
@@ -149,12 +174,13 @@ def _finish(mem: Memory, obs, answers, act: T.Action, asked_about, pending_stop=
     )
 
 
-def _follow_up(mem: Memory, obs: T.Observation, answers: T.Answer, act: T.Action):
+def _follow_up(mem: Memory, obs: T.Observation, answers: T.Answer, act: T.Action, enabled=True):
     """The Type-4 follow-up (paper §3.3, Appendix safeguards): after a yes,
     STOP at once when the answer says "stop now"; when it says "one closer
     move then stop", exactly one MOVE toward the confirmed candidate, then
-    STOP at the next decision. Returns (action, pending_stop)."""
-    yes = (answers.confirm == 1) & (mem.last_asked == 4) & ~answers.refused & (answers.last_type == 4)
+    STOP at the next decision (``enabled``: safeguard 3; when off, a yes
+    is only evidence for the belief). Returns (action, pending_stop)."""
+    yes = (answers.confirm == 1) & (mem.last_asked == 4) & ~answers.refused & (answers.last_type == 4) & enabled
     stop_now = (yes & (answers.follow_up == T.FOLLOW_STOP_NOW)) | mem.pending_stop
     one_move = yes & (answers.follow_up == T.FOLLOW_ONE_MOVE) & ~mem.pending_stop
     dist, bearing = candidate_relative(mem, obs)
@@ -177,7 +203,7 @@ def _explorer_act(params, obs, answers, mem, key, priv):
     U = N_ROOM_LABELS * 8
     b = jnp.concatenate([jnp.where(jnp.arange(valid.shape[0]) == nearest, 1.0, 0.0) * jnp.any(valid),
                          jnp.full(U, 1.0 / U) * (~jnp.any(valid))])
-    act, _ = _move_policy(mem, obs, dataclasses.replace(params, p_stop=jnp.float32(0.5)), b, key, 0.0)
+    act, _ = _move_policy(mem, obs, answers, dataclasses.replace(params, p_stop=jnp.float32(0.5)), b, key, 0.0)
     return act, _finish(mem, obs, answers, act, -1)
 
 
@@ -189,7 +215,7 @@ EXPLORER = Agent("explorer", _belief_init, _explorer_act, default_belief_params,
 
 def _described_act(params, obs, answers, mem, key, priv):
     mem, b = update_belief(params, obs, answers, mem)
-    act, _ = _move_policy(mem, obs, params, b, key, 0.0)
+    act, _ = _move_policy(mem, obs, answers, params, b, key, 0.0)
     return act, _finish(mem, obs, answers, act, -1)
 
 
@@ -210,10 +236,10 @@ def _naive_act(params, obs, answers, mem, key, priv):
                   jnp.where(~answers.known[1], 2,
                             jnp.where(slot4 >= 0, 4, jnp.where((mem.t % 3 == 0) & ~committed, 3, 0))))
     ask = has_q & (q > 0) & ~mem.pending_stop
-    move, _ = _move_policy(mem, obs, params, b, key, 1.5)
+    move, _ = _move_policy(mem, obs, answers, params, b, key, 1.5)
     cand = jnp.where(slot4 >= 0, mem.handle[jnp.maximum(slot4, 0)], -1)
     act = jax.tree.map(lambda a, m: jnp.where(ask, a, m), T.Action.make(T.ASK, question=jnp.maximum(q, 1), candidate=cand), move)
-    act, pending = _follow_up(mem, obs, answers, act)
+    act, pending = _follow_up(mem, obs, answers, act, params.follow_up)
     return act, _finish(mem, obs, answers, act, slot4, pending)
 
 
@@ -223,17 +249,33 @@ NAIVE_ASKER = Agent("naive_asker", _belief_init, _naive_act, default_belief_para
 
 # EIG agent ------------------------------------------------------------------------
 
+PASSAGE_LABELS = ("hallway",)  # room labels of passages (as the Type-3 location analysis counts them)
+_PASSAGE_CODES = tuple(vocab.ALL_ROOM_LABELS.index(label) for label in PASSAGE_LABELS)
+
+
+def in_passage(obs: T.Observation):
+    """() bool: the agent stands in a passage (a room labelled as one, :data:`PASSAGE_LABELS`) or outside every room."""
+    return (obs.room_label < 0) | jnp.any(obs.room_label == jnp.asarray(_PASSAGE_CODES, jnp.int32))
+
+
 def spatial_uncertainty(mem: Memory, obs: T.Observation, answers: T.Answer):
-    """() bool, safeguard 2's situations for a route question: a branch
-    (three or more views open for 2 m), a loop (this spot seen at three or
-    more decisions), a long corridor (open ahead or behind for 3 m, closed
-    at both sides within 1.2 m), or the goal room known while the agent
-    stands elsewhere and has seen no candidate in it."""
+    """() bool, safeguard 2's situations for a route question: in a passage
+    (a room labelled as one, :data:`PASSAGE_LABELS`, or outside every room)
+    at a branch (three or more separate open directions, 2 m free) or in a
+    long corridor (open ahead or behind for 3 m, closed at both sides
+    within 1.2 m); a loop (a MOVE back to a spot seen at two or more
+    earlier decisions); or
+    the goal room known while the agent stands elsewhere and has seen no
+    candidate in it. Inside a closed room the agent searches by itself."""
     free = jnp.mean(obs.free_space, axis=1)  # Shape: (8,) views, relative to the heading
-    branch = jnp.sum(free >= 2.0) >= 3
+    open_ = free >= 2.0
+    runs = jnp.sum(open_ & ~jnp.roll(open_, 1))  # separate open directions (circular runs)
+    passage = in_passage(obs)
+    branch = passage & ((runs >= 3) | ((jnp.sum(open_) >= 3) & ~jnp.all(open_)))
     ij = visit_index(obs.odometry[:2])
-    loop = mem.visits[ij[1], ij[0]] >= 3
-    corridor = (jnp.maximum(free[0], free[4]) >= 3.0) & (free[2] < 1.2) & (free[6] < 1.2)
+    moved_here = (mem.t > 0) & (mem.last_asked == 0) & (obs.last_move > 0.05)  # questions do not make a loop
+    loop = moved_here & (mem.visits[ij[1], ij[0]] >= 3)
+    corridor = passage & (jnp.maximum(free[0], free[4]) >= 3.0) & (free[2] < 1.2) & (free[6] < 1.2)
     valid = (mem.handle >= 0) & ~mem.rejected
     room_known = answers.known[1] & (answers.room_label >= 0)
     entry = room_known & (obs.room_label != answers.room_label) & ~jnp.any(valid & (mem.room == answers.room_label))
@@ -242,8 +284,8 @@ def spatial_uncertainty(mem: Memory, obs: T.Observation, answers: T.Answer):
 
 def _eig_act(params, obs, answers, mem, key, priv):
     mem, b = update_belief(params, obs, answers, mem)
-    exact, slot4 = question_eigs(mem, obs, answers, b)
-    decided, _ = decision_eigs(mem, obs, answers, b)
+    exact, slot4 = question_eigs(mem, obs, answers, b, params.cache_facts)
+    decided, _ = decision_eigs(mem, obs, answers, b, params.cache_facts)
     eigs = jnp.where(params.decision_eig, decided, exact)
     # safeguard 2: route questions where space is uncertain
     eigs = eigs.at[2].multiply(jnp.where(params.type3_gate & ~spatial_uncertainty(mem, obs, answers), 0.0, 1.0))
@@ -251,16 +293,20 @@ def _eig_act(params, obs, answers, mem, key, priv):
     q = jnp.argmax(ratio) + 1
     has_q = (obs.questions_left > 0) & ~mem.pending_stop
     ask = (jnp.max(ratio) > params.threshold) & has_q
-    # safeguard 4: moved for a while, no plausible candidate, never asked for spatial guidance
+    # safeguard 4: moved for a while, no plausible candidate, never asked for spatial guidance: a route question
+    # pays at a lower bar (still EIG / cost, so it too fades as costs rise)
     M = mem.handle.shape[0]
-    lost = (params.recovery_steps > 0) & (mem.t >= params.recovery_steps) & ~answers.known[2] \
-        & (jnp.max(b[:M]) < params.commit) & has_q
+    route = decided[2] / jnp.maximum(params.costs[2], 1e-6)  # the ungated Type-3 value
+    # (it waits for a passage, where a route answer is about the layout, for up to recovery_wait more decisions)
+    where_ok = in_passage(obs) | (mem.t >= params.recovery_steps + params.recovery_wait)
+    lost = (params.recovery_steps > 0) & (mem.t >= params.recovery_steps) & ~answers.known[2] & where_ok \
+        & (jnp.max(b[:M]) < params.commit) & has_q & (route > params.recovery_ratio * params.threshold)
     q = jnp.where(ask, q, jnp.where(lost, 3, q))
     ask = ask | lost
-    move, _ = _move_policy(mem, obs, params, b, key, 2.0)
+    move, _ = _move_policy(mem, obs, answers, params, b, key, 2.0)
     cand = jnp.where(slot4 >= 0, mem.handle[jnp.maximum(slot4, 0)], -1)
     act = jax.tree.map(lambda a, m: jnp.where(ask, a, m), T.Action.make(T.ASK, question=q, candidate=cand), move)
-    act, pending = _follow_up(mem, obs, answers, act)
+    act, pending = _follow_up(mem, obs, answers, act, params.follow_up)
     return act, _finish(mem, obs, answers, act, slot4, pending)
 
 
@@ -268,4 +314,5 @@ EIG = Agent("eig", _belief_init, _eig_act, default_belief_params, asks=True,
             description="cost-aware: asks argmax_t EIG_t / w_t when it exceeds a threshold (Eq. 1 on its belief)")
 
 
-__all__ = ["DEADLINE_STEPS", "DESCRIBED", "EIG", "EXPLORER", "NAIVE_ASKER", "PathParams", "RANDOM", "RandomParams", "SHORTEST_PATH"]
+__all__ = ["DEADLINE_STEPS", "DESCRIBED", "EIG", "EXPLORER", "NAIVE_ASKER", "PASSAGE_LABELS", "PathParams", "RANDOM",
+           "RandomParams", "SHORTEST_PATH", "in_passage", "spatial_uncertainty"]

@@ -61,23 +61,32 @@ Type-3 location (:func:`classify_locations`, :func:`type3_locations`)
 Questions per difficulty (:func:`questions_per_difficulty`)
     Mean |Q| and mean Q_t per difficulty bin over valid episodes.
 
-Delta-U (:func:`delta_u`, paper line ~317)
-    For a Type-3 question at step ``s`` of an episode that used ``n``
-    steps, the matched horizon is ``m = min(h, s, n - 1 - s)`` planner steps
-    (default h = 5; a question with ``m < min_horizon`` is left out). The
+Delta-U (:func:`delta_u`, paper §4.3)
+    The paper: A_noQA is the area explored before a Type-3 question, A_QA
+    the area explored over a matched horizon after incorporating the
+    answer, ``Delta-U = (A_noQA - A_QA) / A_noQA``. Here, for a Type-3
+    question at step ``s`` of an episode that used ``n`` steps, the
+    horizon is ``m = min(h, s)`` planner steps (default h = 5; m = 0 when
+    the question is asked at the episode's last step, ``s = n - 1``, whose
+    answer is never used): the
     *before* path is ``pose[s - m .. s]`` (the m steps before the question),
-    the *after* path ``pose[s + 1 .. s + 1 + m]`` (the m steps after the
-    ASK). The explored area of a path is the area of the coverage cells
-    (``cell`` = 0.25 m squares on a world-aligned lattice) whose centre lies
-    within ``r`` (default 1 m, a short sensing radius) of the path polyline
-    (the segments between consecutive poses, so long MOVEs sweep their whole
-    segment): ``A = cell^2 * #cells``. ``A_noQA`` = area of the before path,
-    ``A_QA`` = area of the after path, ``Delta-U = (A_noQA - A_QA) / A_noQA``
-    (A_noQA >= the area of one disc of radius r > 0). Means per difficulty
-    pool the questions of the bin. A question asked before any horizon
-    exists (at step 0, or at the last step) has m = 0 and is left out, never
-    counted as zero; ASK steps inside either window count as steps that
-    explore nothing, as they do in the episode.
+    the *after* path the same m steps after the ASK, ``pose[s + 1 ..
+    s + 1 + m]``, cut at the episode's end (``pose[n]``): an episode that
+    ends within the horizon explores nothing more, so an answer that leads
+    the agent to stop soon shrinks A_QA (the horizon is matched to the
+    before window, not shortened to the steps left, which would hide that).
+    The explored area of a path is the area of the coverage cells (``cell``
+    = 0.25 m squares on a world-aligned lattice) whose centre lies within
+    ``r`` (default 1 m, a short sensing radius) of the path polyline (the
+    segments between consecutive poses, so long MOVEs sweep their whole
+    segment): ``A = cell^2 * #cells``, at least the area of one disc of
+    radius r, so Delta-U <= 1 - (that disc) / A_noQA and A_noQA > 0.
+    Means per difficulty pool the questions of the bin. Questions with
+    ``m < min_horizon`` (default 1) are left out (``delta_u`` NaN, never
+    counted as zero): one asked before any horizon exists (at step 0; with
+    ``min_horizon=3`` also steps 1-2) and one whose answer is never used
+    (asked at the last step). ASK steps inside either window
+    count as steps that explore nothing, as they do in the episode.
 """
 
 from __future__ import annotations
@@ -533,12 +542,14 @@ def delta_u(poses, events: dict, *, h: int = 5, r: float = 1.0, cell: float = 0.
         poses: (E, S + 1, 2 or 3) trajectory poses.
         events: question events (only Type 3 are used).
         h: horizon in planner steps; r: coverage radius, m; cell: lattice
-            size, m; min_horizon: shortest matched horizon kept.
+            size, m; min_horizon: shortest horizon kept (questions at
+            steps below it have no before window worth the name).
 
     Returns:
-        dict with per-question ``episode``, ``step``, ``horizon``,
+        dict with per-question ``episode``, ``step``, ``horizon`` (m),
         ``area_before`` (A_noQA, m^2), ``area_after`` (A_QA, m^2), ``delta_u``
-        (NaN where the horizon is too short), ``difficulty``; and ``mean``,
+        (NaN where left out: horizon too short, or asked at the last step),
+        ``difficulty``; and ``mean``,
         ``median`` (3,) per difficulty over the kept questions (NaN if none),
         ``count`` (3,), ``mean_all``, ``n_kept``, ``h``, ``r``, ``cell``.
     """
@@ -554,15 +565,15 @@ def delta_u(poses, events: dict, *, h: int = 5, r: float = 1.0, cell: float = 0.
     if ep.size and ((used + 1).max() > pz.shape[1] or ep.max() >= pz.shape[0]):
         raise InputError(None, "poses", f"shape {pz.shape} does not cover the episodes' steps")
     n = len(ep)
-    horizon = np.minimum(np.minimum(h, st), used - 1 - st)
+    horizon = np.where(st < used - 1, np.minimum(h, st), 0)  # no step after the answer: no horizon
     a0 = np.full(n, np.nan)
     a1 = np.full(n, np.nan)
     for i in range(n):
-        m, s, e = int(horizon[i]), int(st[i]), int(ep[i])
+        m, s, e, u = int(horizon[i]), int(st[i]), int(ep[i]), int(used[i])
         if m < min_horizon:
             continue
         a0[i] = explored_area(pz[e, s - m:s + 1, :2], r, cell)
-        a1[i] = explored_area(pz[e, s + 1:s + 2 + m, :2], r, cell)
+        a1[i] = explored_area(pz[e, s + 1:min(s + 1 + m, u) + 1, :2], r, cell)
     with np.errstate(invalid="ignore", divide="ignore"):
         du = (a0 - a1) / a0
     diff = np.asarray(events["difficulty"])[ep]

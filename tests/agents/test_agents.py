@@ -139,12 +139,20 @@ def test_only_the_privileged_agent_receives_privileged_information(small_benchma
 def _reference_likelihoods(mem, obs):
     """The EIG agent's answer models as explicit (A, hypotheses) likelihood
     matrices (see :mod:`ignjax.agents.belief`), for one episode."""
-    L_, C_ = N_ROOM_LABELS, B.N_COLORS
+    L_, N_ = N_ROOM_LABELS, B.N_ATTR_ANSWERS
     U = L_ * 8
+    M_ = mem.handle.shape[0]
     valid = (mem.handle >= 0) & ~mem.rejected
-    col = mem.attrs[:, 0]
-    L1 = jnp.concatenate([jnp.where(col[None] >= 0, (jnp.arange(C_)[:, None] == col[None]).astype(jnp.float32), 1.0 / C_),
-                          jnp.full((C_, U), 1.0 / C_)], axis=1)
+    # Type 1: one answer row per distinct observed attribute combination (its first slot), then every other
+    # combination lumped into one row (each of them leaves the same posterior, so the EIG is unchanged)
+    known = jnp.any(mem.attrs >= 0, axis=1)
+    same = jnp.all(mem.attrs[:, None] == mem.attrs[None], axis=-1) & known[:, None] & known[None]
+    first = known & ~jnp.any(same & (jnp.arange(M_)[None] < jnp.arange(M_)[:, None]), axis=1)
+    G = jnp.sum(first)
+    rows = jnp.where(first[:, None], jnp.where(known[None], same.astype(jnp.float32), 1.0 / N_), 0.0)
+    rows = jnp.concatenate([rows, jnp.where(first[:, None], 1.0 / N_, 0.0) * jnp.ones((1, U))], axis=1)
+    other = jnp.concatenate([jnp.where(known, 0.0, (N_ - G) / N_), jnp.full(U, 1.0) * (N_ - G) / N_])
+    L1 = jnp.concatenate([rows, other[None]], axis=0)
     L2 = jnp.concatenate([jnp.where(mem.room[None] >= 0, (jnp.arange(L_)[:, None] == mem.room[None]).astype(jnp.float32),
                                     1.0 / L_),
                           (jnp.arange(L_)[:, None] == jnp.repeat(jnp.arange(L_), 8)[None]).astype(jnp.float32)], axis=1)

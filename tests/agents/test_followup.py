@@ -121,3 +121,12 @@ def test_no_confirmation_no_follow_up(small_world, poses, fns):
     mem = dataclasses.replace(mem, last_asked=jnp.int32(4), asked_about=jnp.int32(-1))
     act, mem = fns["act"]["eig"](params, fns["observe"](small_world, st), st.answers, mem, jax.random.key(1), None)
     assert not bool(mem.pending_stop)
+
+
+def test_follow_up_can_be_switched_off(small_world, poses, fns):
+    """Safeguard 3 off: a yes is evidence for the belief, not a stop order."""
+    agent = get_agent("eig")
+    params, st, obs, mem = _confirmed(small_world, agent, poses["far"], fns)
+    params = dataclasses.replace(params, follow_up=jnp.array(False))
+    _, mem = fns["act"]["eig"](params, obs, st.answers, mem, jax.random.key(1), None)
+    assert not bool(mem.pending_stop)
