@@ -18,6 +18,8 @@ from ignjax.episodes.dataset import EpisodeSet
 from ignjax.sim.rollout import episode_keys, pad_batch, rollout
 from ignjax.sim.env import check_specs
 from ignjax.sim.world import World
+from ignjax.errors import ConfigError
+from ignjax.protocol import N_VIEWS
 from ignjax.sim.types import SimConfig
 
 
@@ -55,6 +57,9 @@ def run_agent(es: EpisodeSet, agent: Agent | str, *, params=None, batch: int = 2
     agent = get_agent(agent) if isinstance(agent, str) else agent
     params = agent.default_params() if params is None else params
     world = world or make_world(es, config)
+    if world.config.n_views != N_VIEWS:
+        raise ConfigError(None, "sim.n_views", f"the built-in JAX agents plan with {N_VIEWS} views; got "
+                          f"{world.config.n_views} (other view counts are for image-based agents)")
     check_specs(world, es.specs)
     outs = []
     for n_real, specs, keys in episode_batches(es, batch, seed, progress):

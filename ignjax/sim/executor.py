@@ -35,7 +35,7 @@ def pixel_waypoint(world: World, s, pose, direction, col, row):
     cfg = world.config
     W, H = cfg.image_size
     K = G.intrinsics(float(W), float(H), math.radians(cfg.hfov))
-    yaw = pose[2] + direction.astype(jnp.float32) * (math.pi / 4)
+    yaw = pose[2] + direction.astype(jnp.float32) * (2 * math.pi / cfg.n_views)
     uv = G.grid_to_pixel(col, row, float(W), float(H))
     d_c = G.pixel_ray(K, uv)  # z component 1
     R_wc = G.view_rotation(yaw)

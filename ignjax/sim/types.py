@@ -57,6 +57,13 @@ class SimConfig:
         eye_height: camera height, m.
         image_size: (W, H) of a view, pixels (for the grid-to-pixel map).
         hfov: horizontal field of view of a view, degrees.
+        n_views: views of the egocentric panel (4, 8 or 12); a MOVE's
+            ``direction`` k means view k, along ``heading + k * 360 / n_views``
+            degrees (counter-clockwise). The paper's agents use 8; 4 and 12
+            are its observation ablation. The symbolic observation keeps its
+            8 sectors whatever this is, and the built-in JAX agents plan
+            with 8 views (:func:`ignjax.evaluate.runner.run_agent` refuses
+            another value for them).
         depth_range: longest valid depth of a pixel ray, m.
         pullback: distance the waypoint is pulled back from a hit surface, m.
         waypoint_tolerance: a waypoint closer than this is reached, m.
@@ -94,6 +101,7 @@ class SimConfig:
     eye_height: float = 1.25
     image_size: tuple[int, int] = (640, 640)
     hfov: float = 90.0
+    n_views: int = N_VIEWS
     depth_range: float = 10.0
     pullback: float = 0.3
     waypoint_tolerance: float = 0.1
@@ -143,6 +151,8 @@ class SimConfig:
             raise ConfigError(None, "sim.image_size", f"must be [width, height] in pixels (>= 8), got {size!r}")
         if not 0 < self.hfov < 180:
             raise ConfigError(None, "sim.hfov", f"must lie in (0, 180) degrees, got {self.hfov}")
+        if isinstance(self.n_views, bool) or self.n_views not in (4, 8, 12):
+            raise ConfigError(None, "sim.n_views", f"must be 4, 8 or 12 views, got {self.n_views!r}")
         if 0 < self.trace_len < self.max_steps:
             raise ConfigError(None, "sim.trace_len", f"must be >= max_steps ({self.max_steps}) to hold every question attempt")
         object.__setattr__(self, "collision_heights", tuple(float(h) for h in self.collision_heights))
