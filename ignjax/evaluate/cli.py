@@ -7,9 +7,11 @@
 
 Writes ``OUT/outcomes.parquet`` and ``OUT/outcomes.csv`` (one row per agent
 and episode; see :mod:`ignjax.evaluate.outcomes`), ``OUT/metrics.csv`` (every metric per
-agent, overall and per difficulty), ``OUT/run.json`` (every setting used: the
-simulator's, each agent's parameters, costs, thresholds, success rule, seed)
-and prints the paper's Table-1 columns.
+agent, overall and per difficulty), ``OUT/trajectories.npz`` (every agent's
+per-step trajectories, which ``python -m ignjax.view OUT`` replays; a few kB
+per episode and agent, so always written), ``OUT/run.json`` (every setting
+used: the simulator's, each agent's parameters, costs, thresholds, success
+rule, seed) and prints the paper's Table-1 columns.
 
 ``--set sim.<key>=<value>`` sets any :class:`~ignjax.sim.types.SimConfig`
 field and ``--set agents.<name>.<key>=<value>`` any agent parameter (the keys
@@ -115,7 +117,8 @@ def run(args) -> int:
     from ignjax.agents.params import make_params, param_values_of
     from ignjax.episodes.dataset import load_benchmark
     from ignjax.evaluate.runner import make_world, run_agent
-    from ignjax.evaluate.outcomes import metric_rows, outcome_rows, write_metric_table, write_outcomes
+    from ignjax.evaluate.outcomes import (TRAJECTORY_FILE, metric_rows, outcome_rows, write_metric_table,
+                                          write_outcomes, write_trajectories)
 
     agents = [get_agent(a) for a in args.agent]
     sim, agent_values = parse_settings(args.set, [a.name for a in agents])
@@ -132,6 +135,7 @@ def run(args) -> int:
     world = make_world(es, sim)
     print(f"loaded {len(es)} episodes in {len(es.bank.scene_ids)} scenes ({time.perf_counter() - t0:.1f} s)", file=sys.stderr)
     rows = []
+    trajectories = {}
     used: dict[str, dict] = {}
     for agent in agents:
         t1 = time.perf_counter()
@@ -139,14 +143,18 @@ def run(args) -> int:
         # a cost-aware agent plans with the costs it is charged
         params = make_params(agent, agent_values.get(agent.name), costs=costs)
         used[agent.name] = param_values_of(params)
-        out, _ = run_agent(es, agent, params=params, batch=args.batch, seed=args.seed, progress=bar, world=world,
-                           parts=args.parts or None)
+        out, traj = run_agent(es, agent, params=params, batch=args.batch, seed=args.seed, progress=bar, world=world,
+                              parts=args.parts or None)
         rows += outcome_rows(agent.name, es.records, out)
+        trajectories[agent.name] = traj
         print(f"{agent.name}: {len(es)} episodes in {time.perf_counter() - t1:.1f} s", file=sys.stderr)
     out_dir = Path(args.out)
     p_parquet, p_csv = write_outcomes(rows, out_dir)
     metrics = metric_rows(rows, thresholds, costs, args.require_stop)
     write_metric_table(metrics, out_dir / "metrics.csv")
+    write_trajectories(out_dir, trajectories, es.records, episodes=args.episodes, scenes_root=args.scenes_root,
+                       categories=es.bank.categories, thresholds=thresholds, costs=costs,
+                       require_stop=args.require_stop, sim=sim.to_dict())
     run_record = {"episodes": str(args.episodes), "seed": args.seed, "batch": args.batch, "thresholds": list(thresholds),
                   "costs": list(costs), "require_stop": args.require_stop,
                   "success_rule": M.success_rule(args.require_stop), "sim": sim.to_dict(), "agents": used}
@@ -154,7 +162,8 @@ def run(args) -> int:
     print(M.success_rule(args.require_stop))
     if all(t in thresholds for t in SUCCESS_THRESHOLDS):
         print(M.table1(metrics, "text"))
-    print(f"wrote {p_parquet}, {p_csv}, {out_dir / 'metrics.csv'} and {out_dir / 'run.json'}")
+    print(f"wrote {p_parquet}, {p_csv}, {out_dir / 'metrics.csv'}, {out_dir / TRAJECTORY_FILE} and "
+          f"{out_dir / 'run.json'} (view the episodes: python -m ignjax.view {out_dir})")
     return 0
 
 

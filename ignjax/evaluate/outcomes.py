@@ -25,13 +25,22 @@ trace               question attempts as "type@step" (charged) or
 Everything the metrics need is in these columns: :func:`metric_rows`
 recomputes SR, OSR, NE, TL, Q_t, |Q| and WSR from a table read back from
 either file (:func:`read_outcomes`), with any thresholds and costs.
+
+Next to the tables, ``trajectories.npz`` (:func:`write_trajectories`,
+:func:`read_trajectories`) keeps every agent's per-step
+:class:`~ignjax.sim.types.Trajectory` and what is needed to read it (the
+episode file, the category vocabulary its codes index, thresholds, costs,
+the success rule and the simulator settings): the episode viewer
+(:mod:`ignjax.view`) replays a run folder from these files alone.
 """
 
 from __future__ import annotations
 
 import csv
 import io
+import json
 import os
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -42,7 +51,7 @@ from ignjax.errors import InputError
 from ignjax.evaluate import metrics as M
 from ignjax.fileio import atomic_write
 from ignjax.protocol import BIN_INDEX, BIN_NAMES, LOCKED_COSTS, SUCCESS_REQUIRES_STOP, SUCCESS_THRESHOLDS
-from ignjax.sim.types import STOP_REASONS, OutcomeRow
+from ignjax.sim.types import STOP_REASONS, OutcomeRow, Trajectory
 
 COLUMNS: tuple[str, ...] = (
     "agent", "episode_id", "scene_id", "difficulty", "final_distance", "final_euclidean", "min_distance",
@@ -206,5 +215,106 @@ def write_metric_table(metrics: dict[str, dict], path: str | os.PathLike) -> Pat
     return p
 
 
+# ---------------------------------------------------------------------------
+# trajectories
+# ---------------------------------------------------------------------------
+
+TRAJECTORY_FILE = "trajectories.npz"
+"""Name of the trajectory file in a run folder."""
+TRAJECTORY_SCHEMA, TRAJECTORY_VERSION = "ignjax-trajectories", 1
+REQUIRED_TRAJECTORY_FIELDS = ("pose", "kind", "question")
+"""Fields every trajectory file has (the others may be missing from runs
+saved before they were recorded; readers treat them as absent)."""
+
+# storage dtypes: the smallest that holds every value (counts and codes are
+# small; instance handles fit in int16); float fields stay float32
+_STORE = {"pose": np.float32, "waypoint": np.float32, "blocked": np.bool_, "refused": np.bool_,
+          "hint_in_room": np.bool_, "visible_attrs": np.int8}
+
+
+def _member(zf: zipfile.ZipFile, name: str, array: np.ndarray) -> None:
+    buf = io.BytesIO()
+    np.lib.format.write_array(buf, np.asarray(array), allow_pickle=False)
+    # a fixed timestamp and mode: the same trajectories give the same bytes
+    info = zipfile.ZipInfo(name + ".npy", date_time=(1980, 1, 1, 0, 0, 0))
+    info.compress_type = zipfile.ZIP_DEFLATED
+    info.external_attr = 0o644 << 16
+    zf.writestr(info, buf.getvalue(), compresslevel=6)
+
+
+def write_trajectories(folder: str | os.PathLike, trajectories: dict, records: list[dict], *,
+                       episodes: str | os.PathLike, categories, thresholds, costs, require_stop: bool,
+                       sim: dict | None = None, scenes_root: str | os.PathLike | None = None) -> Path:
+    """Write ``folder/trajectories.npz`` atomically (deterministic bytes).
+
+    A zip of ``.npy`` members that :func:`numpy.load` reads without pickle:
+    ``meta`` (a JSON string: ``schema``, ``version``, ``agents``,
+    ``episode_ids`` in row order, ``episodes`` (the episode file, absolute),
+    ``scenes_root``, ``categories`` (the scene bank's vocabulary, which the
+    category codes index), ``thresholds``, ``costs``, ``require_stop``,
+    ``sim``) and, for the i-th agent, ``a<i>.<field>`` for each field of
+    :class:`~ignjax.sim.types.Trajectory` with a leading episode axis.
+
+    Args:
+        trajectories: agent name -> Trajectory (or a dict of its fields),
+            rows in the order of ``records``.
+        records: the episode records the rows belong to.
+    """
+    names = list(trajectories)
+    meta = {"schema": TRAJECTORY_SCHEMA, "version": TRAJECTORY_VERSION, "agents": names,
+            "episode_ids": [r["episode_id"] for r in records], "episodes": str(Path(episodes).resolve()),
+            "scenes_root": str(Path(scenes_root).resolve()) if scenes_root else None,
+            "categories": list(categories), "thresholds": [float(t) for t in thresholds],
+            "costs": [float(c) for c in costs], "require_stop": bool(require_stop), "sim": sim or {}}
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as zf:
+        _member(zf, "meta", np.array(json.dumps(meta, sort_keys=True)))
+        for i, name in enumerate(names):
+            tr = trajectories[name]
+            fields = tr if isinstance(tr, dict) else {f: getattr(tr, f) for f in ("pose",) + Trajectory.STEP_FIELDS}
+            for field in ("pose",) + Trajectory.STEP_FIELDS:
+                if field not in fields:
+                    continue
+                a = np.asarray(fields[field])
+                if len(a) != len(records):
+                    raise ValueError(f"trajectories[{name!r}].{field}: {len(a)} rows for {len(records)} episodes")
+                _member(zf, f"a{i}.{field}", a.astype(_STORE.get(field, np.int16)))
+    return atomic_write(Path(folder) / TRAJECTORY_FILE, buf.getvalue())
+
+
+def read_trajectories(path: str | os.PathLike) -> tuple[dict, dict[str, dict[str, np.ndarray]]]:
+    """(meta, agent name -> field -> array) from a file of :func:`write_trajectories`.
+
+    Raises:
+        InputError: missing or unreadable file, another schema or version,
+            or a required field missing.
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise InputError(p, None, "no such file")
+    try:
+        with np.load(p, allow_pickle=False) as z:
+            arrays = {k: z[k] for k in z.files}
+    except (OSError, ValueError, zipfile.BadZipFile) as e:
+        raise InputError(p, None, f"not a trajectory file: {e}") from e
+    if "meta" not in arrays:
+        raise InputError(p, "meta", "missing: not a trajectory file of ignjax")
+    try:
+        meta = json.loads(str(arrays.pop("meta").reshape(-1)[0]))
+    except json.JSONDecodeError as e:
+        raise InputError(p, "meta", f"not JSON: {e}") from e
+    if meta.get("schema") != TRAJECTORY_SCHEMA or meta.get("version") != TRAJECTORY_VERSION:
+        raise InputError(p, "meta", f"schema {meta.get('schema')!r} version {meta.get('version')!r}; "
+                                    f"expected {TRAJECTORY_SCHEMA!r} version {TRAJECTORY_VERSION}")
+    out: dict[str, dict[str, np.ndarray]] = {}
+    for i, name in enumerate(meta["agents"]):
+        fields = {k.split(".", 1)[1]: v for k, v in arrays.items() if k.split(".", 1)[0] == f"a{i}"}
+        missing = [f for f in REQUIRED_TRAJECTORY_FIELDS if f not in fields]
+        if missing:
+            raise InputError(p, f"agent {name!r}", f"missing fields {missing}")
+        out[name] = fields
+    return meta, out
+
+
 __all__ = ["COLUMNS", "BIN_NAMES", "outcome_rows", "write_outcomes", "read_outcomes", "to_metric_outcomes", "metric_rows",
-           "write_metric_table", "parse_trace"]
+           "write_metric_table", "parse_trace", "TRAJECTORY_FILE", "write_trajectories", "read_trajectories"]

@@ -26,6 +26,50 @@ DEPTH_EXACT_PRIMS = 8  # primitives tested exactly per occupied voxel by the dep
 DEPTH_ITERATIONS = 64  # traversal steps of the depth ray (free space is crossed several voxels at a time)
 
 
+def cell_ray(cfg: T.SimConfig, pose, direction, col, row):
+    """The executor's pixel ray of a grid cell of view ``direction``: the
+    ray through the cell's centre pixel (Eq. app:grid-to-pixel) from the
+    eye at ``eye_height``, pitch 0.
+
+    Returns:
+        (K, uv, R_wc, t_wc, d_w): intrinsics, centre pixel, camera-to-world
+        rotation, eye (3,), and the world direction ``R_wc K^-1 [u, v, 1]``
+        (3,), whose projection on the optical axis is 1.
+    """
+    W, H = cfg.image_size
+    K = G.intrinsics(float(W), float(H), math.radians(cfg.hfov))
+    yaw = pose[2] + direction.astype(jnp.float32) * (2 * math.pi / cfg.n_views)
+    uv = G.grid_to_pixel(col, row, float(W), float(H))
+    R_wc = G.view_rotation(yaw)
+    t_wc = jnp.array([pose[0], pose[1], cfg.eye_height], jnp.float32)
+    return K, uv, R_wc, t_wc, G.matvec3(R_wc, G.pixel_ray(K, uv))
+
+
+def cell_depth(world: World, s, pose, direction, col, row):
+    """The executor's depth of a grid cell: z-depth along the optical axis
+    of the first surface on the cell's pixel ray, by ray casting (voxel
+    traversal with exact primitive tests, :func:`ignjax.sim.rays.queries.march`).
+    A surface whose horizontal distance exceeds ``horizon + pullback``
+    yields the same clipped waypoint as no surface, so the ray is followed
+    only that far (as a 3-D range, for rays up to :data:`DEPTH_ELEVATION` steep).
+
+    Returns:
+        (z (), valid ()): ``valid`` is false when no surface lies within range.
+    """
+    cfg = world.config
+    _, _, _, t_wc, d_w = cell_ray(cfg, pose, direction, col, row)
+    norm = jnp.sqrt(d_w[0] * d_w[0] + d_w[1] * d_w[1] + d_w[2] * d_w[2])
+    u = d_w / norm
+    horiz = jnp.sqrt(u[0] * u[0] + u[1] * u[1])
+    reach = (cfg.horizon + cfg.pullback + world.bank.grid.resolution) / jnp.maximum(horiz, 1e-3)
+    static = min(cfg.depth_range, (cfg.horizon + cfg.pullback + world.bank.grid.resolution) / math.cos(DEPTH_ELEVATION))
+    dist = SR.march(world.bank.rays, s, t_wc, u, jnp.minimum(jnp.minimum(reach, static), cfg.depth_range),
+                    static_range=static, outside_hits=False, exact=DEPTH_EXACT_PRIMS,
+                    iterations=DEPTH_ITERATIONS)
+    valid = jnp.isfinite(dist) & (dist <= cfg.depth_range)
+    return jnp.where(valid, dist / norm, 0.0), valid  # d_w has unit projection on the optical axis
+
+
 def pixel_waypoint(world: World, s, pose, direction, col, row):
     """The executor's waypoint for a grid cell of a view (before the controller).
 
@@ -33,27 +77,10 @@ def pixel_waypoint(world: World, s, pose, direction, col, row):
         (waypoint (2,), hit_obstacle (), used_depth (), used_floor ()).
     """
     cfg = world.config
-    W, H = cfg.image_size
-    K = G.intrinsics(float(W), float(H), math.radians(cfg.hfov))
+    K, uv, R_wc, t_wc, d_w = cell_ray(cfg, pose, direction, col, row)
     yaw = pose[2] + direction.astype(jnp.float32) * (2 * math.pi / cfg.n_views)
-    uv = G.grid_to_pixel(col, row, float(W), float(H))
-    d_c = G.pixel_ray(K, uv)  # z component 1
-    R_wc = G.view_rotation(yaw)
-    t_wc = jnp.array([pose[0], pose[1], cfg.eye_height], jnp.float32)
-    d_w = G.matvec3(R_wc, d_c)
-    norm = jnp.sqrt(d_w[0] * d_w[0] + d_w[1] * d_w[1] + d_w[2] * d_w[2])
-    u = d_w / norm
-    # depth by ray casting: voxel traversal with exact primitive tests (SR.march). A surface whose
-    # horizontal distance exceeds horizon + pullback yields the same clipped waypoint as no surface,
-    # so the ray is followed only that far (as a 3-D range, for rays up to DEPTH_ELEVATION steep).
-    horiz = jnp.sqrt(u[0] * u[0] + u[1] * u[1])
-    reach = (cfg.horizon + cfg.pullback + world.bank.grid.resolution) / jnp.maximum(horiz, 1e-3)
-    static = min(cfg.depth_range, (cfg.horizon + cfg.pullback + world.bank.grid.resolution) / math.cos(DEPTH_ELEVATION))
-    dist = SR.march(world.bank.rays, s, t_wc, u, jnp.minimum(jnp.minimum(reach, static), cfg.depth_range),
-                    static_range=static, outside_hits=False, exact=DEPTH_EXACT_PRIMS,
-                    iterations=DEPTH_ITERATIONS)
-    valid_depth = jnp.isfinite(dist) & (dist <= cfg.depth_range)
-    z = jnp.where(valid_depth, dist / norm, 0.0)  # z-depth along the optical axis (d_c has z = 1)
+    u = d_w / jnp.sqrt(d_w[0] * d_w[0] + d_w[1] * d_w[1] + d_w[2] * d_w[2])
+    z, valid_depth = cell_depth(world, s, pose, direction, col, row)
     x_c = G.backproject(K, uv, z)
     x_w = G.camera_to_world(R_wc, t_wc, x_c)
     floor_pt, floor_ok = G.floor_intersection(t_wc, d_w)

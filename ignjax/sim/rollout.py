@@ -20,8 +20,13 @@ also receive :class:`~ignjax.sim.types.Privileged` information
 (:func:`ignjax.sim.env.privileged_info`).
 
 Besides the outcome row, a rollout records a compact trajectory per episode
-(:class:`~ignjax.sim.types.Trajectory`: pose after every step, action kind
-and question type), used for trajectory plots and the interaction analyses.
+(:class:`~ignjax.sim.types.Trajectory`: pose after every step, the decision
+with its MOVE cell or question, the executor's waypoint and blocked
+headings, the oracle's answer codes, the charged questions, and the
+instances in sight when the agent decided; :func:`step_record`), used for
+trajectory plots, the interaction analyses and the episode viewer
+(:mod:`ignjax.view`). The record only copies values the step computed
+anyway.
 """
 
 from __future__ import annotations
@@ -41,6 +46,36 @@ from ignjax.sim.compact import chunk_size, even_chunk, first_equal, masked_map
 from ignjax.sim.world import World
 
 
+def step_record(obs: T.Observation, action: T.Action, kind, before: T.SimState, after: T.SimState) -> tuple:
+    """One step's entry of the :class:`~ignjax.sim.types.Trajectory`, for one
+    episode or a batch (leading axes alike): the observation the agent
+    decided on, its action, the kind recorded (-1 once the episode had
+    ended) and the state before and after the step. Returns the values of
+    :attr:`~ignjax.sim.types.Trajectory.STEP_FIELDS`, in that order."""
+    i32 = jnp.int32
+    is_move = kind == T.MOVE
+    is_ask = kind == T.ASK
+    q = jnp.where(is_ask, jnp.clip(action.question, 1, 4), 0).astype(i32)
+    on_move = lambda v, lo, hi: jnp.where(is_move, jnp.clip(v, lo, hi), -1).astype(i32)  # noqa: E731
+    a = after.answers
+    candidate = jnp.where(is_ask & (q == 4), action.candidate, -1).astype(i32)
+    waypoint = jnp.where(is_move[..., None], after.waypoint, before.pose[..., :2])
+    return (kind.astype(i32), q, on_move(action.direction, 0, 7), on_move(action.col, 1, 8),
+            on_move(action.row, 1, 8), candidate, waypoint, after.blocked & is_move[..., None],
+            is_ask & a.refused, after.n_questions, a.confirm, a.follow_up, a.hint_room_label, a.hint_sector,
+            a.hint_landmark, a.hint_in_room, a.hint_progress, obs.room_label, obs.visible_handle,
+            obs.visible_attrs.astype(jnp.int8))
+
+
+def _trajectory(start, poses, steps: tuple, axis: int) -> T.Trajectory:
+    """The Trajectory from the start poses and the scan's stacked step
+    records (step axis first); ``axis`` is where the step axis goes (0 for
+    one episode, 1 for a batch)."""
+    move = (lambda x: x) if axis == 0 else (lambda x: jnp.swapaxes(x, 0, 1))
+    pose = jnp.concatenate([jnp.expand_dims(start.astype(jnp.float32), axis), move(poses)], axis)
+    return T.Trajectory(pose=pose, **{name: move(v) for name, v in zip(T.Trajectory.STEP_FIELDS, steps)})
+
+
 def rollout_episode(world: World, spec: T.EpisodeSpec, agent, params, key: jax.Array):
     """Run one episode to the end. Returns (OutcomeRow, Trajectory, final SimState)."""
     cfg = world.config
@@ -54,17 +89,17 @@ def rollout_episode(world: World, spec: T.EpisodeSpec, agent, params, key: jax.A
         state, obs, pstate, priv = carry
         action, pstate = agent.act(params, obs, state.answers, pstate, k, priv)
         was_done = state.done
+        before = state
         state = E.step(world, state, action)
+        kind = jnp.where(was_done, -1, jnp.clip(action.kind, 0, 2))
+        record = step_record(obs, action, kind, before, state)
         obs = E.observe(world, state)
         priv = E.privileged_info(world, state) if agent.privileged else None
-        kind = jnp.where(was_done, -1, jnp.clip(action.kind, 0, 2))
-        q = jnp.where((kind == T.ASK), jnp.clip(action.question, 1, 4), 0)
-        return (state, obs, pstate, priv), (state.pose, kind.astype(jnp.int32), q.astype(jnp.int32))
+        return (state, obs, pstate, priv), (state.pose, record)
 
     keys = jax.random.split(key, cfg.max_steps)
-    (state, _, _, _), (poses, kinds, qs) = jax.lax.scan(body, (state, obs, pstate, priv0), keys)
-    traj = T.Trajectory(pose=jnp.concatenate([spec.start[None].astype(jnp.float32), poses]), kind=kinds, question=qs)
-    return E.outcome(world, state), traj, state
+    (state, _, _, _), (poses, steps) = jax.lax.scan(body, (state, obs, pstate, priv0), keys)
+    return E.outcome(world, state), _trajectory(spec.start, poses, steps, 0), state
 
 
 # Compiler options of the rollout jits. XLA:CPU compiles loop bodies (the scan
@@ -250,6 +285,7 @@ def rollout_rows(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.Ar
         # unfinished rows would gather and scatter the agents' whole memory every step, which costs more
         action, pstate = jax.lax.map(act, (params, obs, state.answers, pstate, k, priv), batch_size=act_chunk)
         kind = jnp.where(was_done, -1, jnp.clip(action.kind, 0, 2))
+        before, obs_before = state, obs
         if group is None:
             state, obs, priv = simulate(state, obs, priv, action, kind == T.MOVE, chunk)
         else:
@@ -261,14 +297,13 @@ def rollout_rows(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.Ar
             out = simulate(sim, obs, priv, action, (kind == T.MOVE) & lead, group_chunk)
             state, obs, priv = jax.tree.map(lambda a: a[rep], out)
             group = rep
-        q = jnp.where((kind == T.ASK), jnp.clip(action.question, 1, 4), 0)
-        return (state, obs, pstate, priv, group), (state.pose, kind.astype(jnp.int32), q.astype(jnp.int32))
+        record = step_record(obs_before, action, kind, before, state)
+        return (state, obs, pstate, priv, group), (state.pose, record)
 
     groups = None if groups is None else jnp.asarray(groups, jnp.int32)
     group_chunk = chunk if group_chunk is None else group_chunk
-    (state, _, _, _, _), (poses, kinds, qs) = jax.lax.scan(body, (state, obs, pstate, priv0, groups), step_keys)
-    traj = T.Trajectory(pose=jnp.concatenate([specs.start[:, None].astype(jnp.float32), jnp.swapaxes(poses, 0, 1)], 1),
-                      kind=kinds.T, question=qs.T)
+    (state, _, _, _, _), (poses, steps) = jax.lax.scan(body, (state, obs, pstate, priv0, groups), step_keys)
+    traj = _trajectory(specs.start, poses, steps, 1)
     return jax.vmap(lambda st: E.outcome(world, st))(state), traj, state
 
 

@@ -516,17 +516,77 @@ class OutcomeRow:
 
 @pytree_dataclass
 class Trajectory:
-    """Per-step record of one episode.
+    """Per-step record of one episode: what the agent decided on, what it
+    decided, and what the simulator answered (what the episode viewer,
+    :mod:`ignjax.view`, replays and the trajectory plots and interaction
+    analyses read).
+
+    S is ``max_steps``; the steps after the episode ended have ``kind ==
+    -1`` (their other entries are the fill values below or repeat the final
+    state). Everything the viewer
+    words (the oracle's answers through :mod:`ignjax.sim.oracle_text`) is
+    kept as the simulator's codes, not text, so the record stays a few
+    hundred bytes per episode and step.
 
     Attributes:
         pose: (S + 1, 3) float32 pose before the first step and after each step.
         kind: (S,) int32 action kind of each step (-1 after the episode ended).
         question: (S,) int32 question type of ASK steps, 0 otherwise.
+        direction, col, row: (S,) int32 the MOVE's view (0..7) and grid
+            cell (column and row 1..8), as executed (clamped into range);
+            -1 for other steps.
+        candidate: (S,) int32 the instance handle a Type-4 question asked
+            about (-1: "what is in front of me", and for other steps).
+        waypoint: (S, 2) float32 the executor's waypoint of a MOVE (world);
+            the pose before the step for other steps.
+        blocked: (S, 8) bool headings (relative to the yaw before the MOVE,
+            view layout) found blocked during a MOVE; False for other steps.
+        refused: (S,) bool the step's question was refused (budget spent).
+        n_questions: (S, 4) int32 charged questions per type after the step
+            (the running cost discount; with ``upfront_description`` it
+            starts at one Type-1 and one Type-2).
+        confirm, follow_up: (S,) int32 the Type-4 answer and follow-up
+            state after the step (:class:`Answer` codes).
+        hint_room_label, hint_sector, hint_landmark: (S,) int32 the Type-3
+            answer's facts after the step.
+        hint_in_room: (S,) bool the Type-3 route stays in the room.
+        hint_progress: (S,) int32 the active hint's progress code after the step.
+        room_label: (S,) int32 the room label the agent perceived when it
+            decided (the observation before the step).
+        visible: (S, K) int32 handles of the instances in sight when it
+            decided (the scene's instance index; -1 empty), K = ``max_visible``.
+        visible_attrs: (S, K, 4) int8 their perceived colour, material,
+            size and state codes (differ from the scene's under perception
+            noise; -1 unknown).
     """
 
     pose: jax.Array
     kind: jax.Array
     question: jax.Array
+    direction: jax.Array
+    col: jax.Array
+    row: jax.Array
+    candidate: jax.Array
+    waypoint: jax.Array
+    blocked: jax.Array
+    refused: jax.Array
+    n_questions: jax.Array
+    confirm: jax.Array
+    follow_up: jax.Array
+    hint_room_label: jax.Array
+    hint_sector: jax.Array
+    hint_landmark: jax.Array
+    hint_in_room: jax.Array
+    hint_progress: jax.Array
+    room_label: jax.Array
+    visible: jax.Array
+    visible_attrs: jax.Array
+
+    STEP_FIELDS = ("kind", "question", "direction", "col", "row", "candidate", "waypoint", "blocked", "refused",
+                   "n_questions", "confirm", "follow_up", "hint_room_label", "hint_sector", "hint_landmark",
+                   "hint_in_room", "hint_progress", "room_label", "visible", "visible_attrs")
+    """The fields with one entry per step (every field but ``pose``), in
+    the order :func:`ignjax.sim.rollout.step_record` returns them."""
 
 
 @pytree_dataclass

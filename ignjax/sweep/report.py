@@ -19,7 +19,7 @@ import numpy as np
 
 from ignjax.config import SweepConfig
 from ignjax.evaluate import metrics as M
-from ignjax.evaluate.outcomes import metric_rows, outcome_rows, write_metric_table, write_outcomes
+from ignjax.evaluate.outcomes import metric_rows, outcome_rows, write_metric_table, write_outcomes, write_trajectories
 from ignjax.fileio import atomic_write
 from ignjax.protocol import BIN_INDEX, BIN_NAMES, FACTOR_NAMES, SUCCESS_THRESHOLDS
 from ignjax.scenes.viz.mapplot import plot_scene_map, save_figure
@@ -28,6 +28,11 @@ from ignjax.studies import cost_sensitivity as CS
 from ignjax.studies import difficulty_ablation as DA
 from ignjax.studies import interaction as IA
 from ignjax.studies._common import new_figure, save
+from ignjax.view.page import write_page
+from ignjax.view.runfolder import read_run
+
+VIEWER_FILE = "viewer.html"
+"""The episode viewer page the eval study writes next to the outcomes (:mod:`ignjax.view`)."""
 
 
 def _fmt(v) -> str:
@@ -75,15 +80,24 @@ def factors_of(es) -> np.ndarray:
 
 
 def study_eval(es, rollouts: dict, cfg: SweepConfig, out: Path) -> dict:
+    """Outcome tables, metrics, every agent's trajectories and the episode viewer page (:data:`VIEWER_FILE`),
+    drawn from the scenes already in memory."""
     rows = []
+    trajectories = {}
     for name, tree in rollouts.items():
         if name not in cfg.eval.agents:
             continue
         rows += outcome_rows(name, es.records, SimpleNamespace(**tree["out"]))
+        trajectories[name] = tree["traj"]
     write_outcomes(rows, out)
     metrics = metric_rows(rows, tuple(cfg.eval.thresholds), tuple(cfg.eval.costs), cfg.eval.require_stop)
     write_metric_table(metrics, out / "metrics.csv")
-    return {"rows": rows, "metrics": metrics}
+    write_trajectories(out, trajectories, es.records, episodes=es.path, categories=es.bank.categories,
+                       thresholds=cfg.eval.thresholds, costs=cfg.eval.costs, require_stop=cfg.eval.require_stop,
+                       sim=cfg.to_dict()["sim"])
+    scenes = {sid: es.bank.scene(i) for i, sid in enumerate(es.bank.scene_ids)}
+    viewer = write_page(read_run(out, scenes=scenes, title=cfg.run.name), out / VIEWER_FILE)
+    return {"rows": rows, "metrics": metrics, "viewer": viewer}
 
 
 def in_loop_costs(cfg: SweepConfig) -> tuple[np.ndarray, list[str]]:
@@ -313,7 +327,12 @@ def _section_eval(results: dict, es, rollouts: dict, cfg, out: Path) -> list[str
              "repeat SR@1.5, WSR@1.5 and |Q| per difficulty. `shortest_path` is privileged (an upper bound).", ""]
     if all(t in cfg.eval.thresholds for t in SUCCESS_THRESHOLDS):
         parts += [M.table1(ev["metrics"], "markdown"), ""]
-    parts += ["Per-episode outcomes: `outcomes.parquet`, `outcomes.csv`; metrics: `metrics.csv`.", ""]
+    parts += ["Per-episode outcomes: `outcomes.parquet`, `outcomes.csv`; metrics: `metrics.csv`; per-step "
+              "trajectories: `trajectories.npz`.", "",
+              f"Episode viewer: [{VIEWER_FILE}]({VIEWER_FILE}) (one self-contained page: every episode of every "
+              "agent, sortable and filterable, replayed step by step on the map with the oracle's answers; "
+              "`python -m ignjax.view RUN_DIR` (this folder) rebuilds it, `--gif EPISODE_ID --agent NAME` exports "
+              "one episode as an animation).", ""]
     return parts
 
 
@@ -434,5 +453,5 @@ def write_outputs(results: dict, out: Path) -> None:
     atomic_write(out / "report.md", "\n".join(parts))
 
 
-__all__ = ["SECTIONS", "settings_lines", "agent_arrays", "factors_of", "in_loop_costs", "plot_trajectories", "study_analysis", "study_costs",
+__all__ = ["SECTIONS", "VIEWER_FILE", "settings_lines", "agent_arrays", "factors_of", "in_loop_costs", "plot_trajectories", "study_analysis", "study_costs",
            "study_derive_costs", "study_difficulty", "study_eval", "write_csv", "write_outputs"]
