@@ -144,7 +144,11 @@ def cmd_render(args) -> int:
     from ignjax.scenes.io.sources import load_scenes
     from ignjax.scenes.viz.mapplot import plot_scene_map
     from ignjax.scenes.navgrid import GridConfig, build_navgrid
-    from ignjax.scenes.viz.render import VIEW_NAMES, ViewRenderer, save_png
+    from ignjax.protocol import VIEW_NAMES
+    from ignjax.scenes.bank import SceneBank
+    from ignjax.scenes.viz.render import save_png
+    from ignjax.sim.types import SimConfig
+    from ignjax.sim.views import ViewConfig, ViewRenderer
 
     scenes = load_scenes(args.path)
     if args.scene:
@@ -155,10 +159,10 @@ def cmd_render(args) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     compiled = compile_scene(scene)
+    grid = build_navgrid(compiled, GridConfig())
     if args.pose:
         x, y, yaw = (float(v) for v in args.pose.split(","))
     else:  # the navigable cell farthest from obstacles in the first room, facing its centroid
-        grid = build_navgrid(compiled, GridConfig())
         room0 = grid.room_index(scene.rooms[0].id)
         clear = np.where(grid.navigable & (grid.room == room0), grid.clearance, -1)
         r, c = np.unravel_index(int(np.argmax(clear)), clear.shape)
@@ -166,16 +170,18 @@ def cmd_render(args) -> int:
         cx, cy = scene.rooms[0].centroid
         yaw = math.atan2(cy - y, cx - x) if (cx - x) ** 2 + (cy - y) ** 2 > 0.25 else 0.0
     plot_scene_map(scene, out / f"{scene.id}_map.png")
-    with ViewRenderer(compiled.model, compiled.data, args.size, args.size, 90.0) as r:
-        views = r.panorama((x, y, 1.25), yaw, -0.2)
-    save_png(views[0], out / f"{scene.id}_front.png")
-    # 3 x 3 panel in the paper's layout: front-left, front, front-right / left, -, right / rear-left, rear, rear-right
-    layout = [[1, 0, 7], [2, None, 6], [3, 4, 5]]
-    tile = np.full((args.size, args.size, 3), 255, np.uint8)
-    panel = np.concatenate([np.concatenate([views[k] if k is not None else tile for k in row], 1) for row in layout], 0)
+    # the views as the agents see them (ignjax.sim.views): executor cameras, Planner panel, Grounder image
+    bank = SceneBank.from_compiled([compiled], [grid])
+    with ViewRenderer(bank, SimConfig(), ViewConfig(size=args.size, backend=args.backend)) as r:
+        views = r.render([0], [[x, y, yaw]])
+        panel = r.panels(views)[0]
+        grounder = r.grounder_images(views, [0])[0]
+    save_png(views.rgb[0, 0], out / f"{scene.id}_front.png")
     save_png(panel, out / f"{scene.id}_panorama.png")
-    print(f"wrote {out / (scene.id + '_map.png')}, {out / (scene.id + '_front.png')} and "
-          f"{out / (scene.id + '_panorama.png')} (eye at x={x:.2f}, y={y:.2f}, yaw={yaw:.2f}; views {', '.join(VIEW_NAMES)})")
+    save_png(grounder, out / f"{scene.id}_grounder.png")
+    print(f"wrote {out / (scene.id + '_map.png')}, {out / (scene.id + '_front.png')}, "
+          f"{out / (scene.id + '_panorama.png')} and {out / (scene.id + '_grounder.png')} "
+          f"(eye at x={x:.2f}, y={y:.2f}, yaw={yaw:.2f}; {r.backend} backend; views {', '.join(VIEW_NAMES)})")
     return 0
 
 
@@ -209,12 +215,14 @@ def build_parser() -> argparse.ArgumentParser:
                         "center, size (full box extents) and yaw of its box, metres, Z-up")
     i.set_defaults(func=cmd_inspect)
 
-    r = sub.add_parser("render", help="draw a scene's top-down map and render a first-person 8-view panorama")
+    r = sub.add_parser("render", help="draw a scene's top-down map and render the Planner panel and a Grounder image")
     r.add_argument("path", help="a scene source (USD, ProcTHOR JSON, glTF/GLB/OBJ, scene folder)")
     r.add_argument("--scene", help="scene id, when the source holds several (default: the first)")
     r.add_argument("--out", default=".", help="output folder (default: current folder)")
     r.add_argument("--pose", help="eye pose x,y,yaw (metres, radians); default: an open spot of the first room")
-    r.add_argument("--size", type=int, default=320, help="pixels per view (default 320)")
+    r.add_argument("--size", type=int, default=448, help="pixels per view, 64..1024 (default 448)")
+    r.add_argument("--backend", default="auto", choices=("auto", "warp", "egl"),
+                   help="renderer (default auto: MuJoCo Warp when installed, else OpenGL)")
     r.set_defaults(func=cmd_render)
 
     e = sub.add_parser("episodes", help="build a benchmark from scenes, or --check an episode file")

@@ -1,7 +1,7 @@
 """``python -m ignjax.build render`` run as a user runs it (a subprocess) on a
 small scene written to a temporary folder: it writes the top-down map, the
-front view (``--size`` pixels square) and the 3 x 3 panorama panel (three
-views a side), and none of them is blank.
+front view (``--size`` pixels square), the Planner panel (3 x 3 views) and
+the Grounder image, and none of them is blank.
 
 Rendering needs headless OpenGL: the test uses the first of
 ``$MUJOCO_GL`` (default ``egl``) and ``osmesa`` that can open a MuJoCo
@@ -20,7 +20,7 @@ import pytest
 
 from ignjax.scenes.io.usd import save_usd
 
-SIZE = 48
+SIZE = 64
 
 _PROBE = ("import mujoco\n"
           "m = mujoco.MjModel.from_xml_string(\"<mujoco><worldbody><geom size='1 1 .1' type='plane'/></worldbody></mujoco>\")\n"
@@ -68,27 +68,26 @@ def _image(path) -> np.ndarray:
 
 def test_render_writes_the_promised_images(rendered):
     out, sid, stdout = rendered
-    names = {f"{sid}_map.png", f"{sid}_front.png", f"{sid}_panorama.png"}
+    names = {f"{sid}_map.png", f"{sid}_front.png", f"{sid}_panorama.png", f"{sid}_grounder.png"}
     assert {p.name for p in out.iterdir()} == names  # nothing else (no temporary files left behind)
     for name in names:
         assert name in stdout
     assert _image(out / f"{sid}_front.png").shape == (SIZE, SIZE, 3)
     assert _image(out / f"{sid}_panorama.png").shape == (3 * SIZE, 3 * SIZE, 3)
+    assert _image(out / f"{sid}_grounder.png").shape == (SIZE, SIZE, 3)
     assert min(_image(out / f"{sid}_map.png").shape[:2]) >= 100
 
 
 def test_rendered_images_are_not_blank(rendered):
     out, sid, _ = rendered
-    for name in ("map", "front", "panorama"):
+    for name in ("map", "front", "panorama", "grounder"):
         img = _image(out / f"{sid}_{name}.png")
         assert img.var() > 1e-4, name
-    # each of the panel's eight views shows something (the centre tile is the blank filler)
+    # every cell of the panel shows something: eight views around the orientation cell
     panel = _image(out / f"{sid}_panorama.png")
     tiles = {(i, j): panel[i * SIZE:(i + 1) * SIZE, j * SIZE:(j + 1) * SIZE] for i in range(3) for j in range(3)}
     for (i, j), tile in tiles.items():
-        if (i, j) == (1, 1):
-            assert np.all(tile == 1.0)
-        else:
-            assert tile.var() > 1e-4, (i, j)
-    # the front view is the panel's top-middle tile
-    np.testing.assert_allclose(tiles[(0, 1)], _image(out / f"{sid}_front.png"), atol=1 / 255)
+        assert tile.var() > 1e-4, (i, j)
+    # the front view is the panel's top-middle tile, under its label and grid lines
+    same = np.all(np.abs(tiles[(0, 1)] - _image(out / f"{sid}_front.png")) <= 1 / 255, axis=-1)
+    assert same.mean() > 0.6
