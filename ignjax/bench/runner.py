@@ -51,6 +51,7 @@ def main(argv=None) -> int:
     import jax
 
     from ignjax.bench.rays import bench_probe_rays, bench_rays
+    from ignjax.bench.render import bench_render
     from ignjax.bench.rollouts import AGENTS, bench_steps, bench_studies
     from ignjax.episodes.dataset import load_benchmark
     from ignjax.evaluate.runner import make_world
@@ -72,6 +73,8 @@ def main(argv=None) -> int:
         f"{k} {v:.4f}" for k, v in res["probe_ray_agreement"].items()))
     es = load_benchmark(args.episodes or SHIPPED_BENCHMARK)
     world = make_world(es)
+    log("rendered observations ...")
+    res["render"] = bench_render(es.bank, args.quick)
     log("decision steps ...")
     agents = ("random", "eig") if args.quick else AGENTS
     sizes = (256, 1024, 4096)

@@ -98,3 +98,10 @@ def test_quick_json_line():
     res = json.loads(lines[-1])
     assert isinstance(res, dict)
     check_record(res)
+    r = res["render"]
+    assert r["views"] == 8 and r["batch"] == 8
+    assert set(r["panels_per_s"]) == {"warp@224", "warp@128", "egl@224", "egl@128"}
+    for key, v in r["panels_per_s"].items():
+        assert v is None or v > 0, key
+    if r["depth_agreement"] is not None:
+        assert r["depth_agreement"] > 0.95 and r["segmentation_agreement"] > 0.95
