@@ -126,7 +126,7 @@ def test_every_sim_field_and_agent_parameter_is_a_config_key():
     of sweeps/default.toml."""
     changed = {"max_steps": 24, "max_questions": 7, "horizon": 2.5, "collision_distance": 0.5,
                "collision_heights": [0.2, 0.9], "micro_step": 0.4, "max_micro_steps": 6, "eye_height": 1.1,
-               "image_size": [320, 240], "hfov": 80.0, "depth_range": 8.0, "pullback": 0.25, "waypoint_tolerance": 0.2,
+               "image_size": [320, 240], "hfov": 80.0, "n_views": 12, "depth_range": 8.0, "pullback": 0.25, "waypoint_tolerance": 0.2,
                "hint_lookahead": 3.0, "confirm_range": 2.5, "stop_radius": 0.8, "hint_reached": 0.7,
                "obs_rays_per_view": 4, "obs_range": 5.0, "max_visible": 12, "trace_len": 30, "question_budget": False,
                "upfront_description": True, "miss_rate": 0.2, "confusion_rate": 0.1}

@@ -227,9 +227,10 @@ def _file_name(asset: str) -> str:
 
 def unresolved_summary(messages: list[str], examples: int = 3, note: str = "") -> str:
     """``"N asset references could not be resolved<note>, e.g. a; b; c"`` for
-    the messages of unresolved-asset composition errors."""
+    the messages of unresolved-asset composition errors; the examples are the
+    first in sorted order (USD reports them in no fixed order)."""
     n = len(messages)
-    listed = "; ".join(_asset_example(m) for m in messages[:examples])
+    listed = "; ".join(sorted(_asset_example(m) for m in messages)[:examples])
     more = f"; and {n - examples} more" if n > examples else ""
     return f"{n} asset reference{'s' if n != 1 else ''} could not be resolved{note}, e.g. {listed}{more}"
 
