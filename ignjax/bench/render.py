@@ -5,7 +5,9 @@ episode (RGB, depth, segmentation), the Planner panel composed, the
 Grounder image of the front view with its grid, and both encoded (JPEG).
 Both backends render the same B random navigable poses of the first scene
 of the benchmark's bank in the same run, after one untimed warm-up call
-(contexts and compilation); ``panels_per_s`` = B / seconds of one timed
+(contexts and compilation), with one render process per CPU core
+(``ViewConfig.workers``, recorded as ``workers``; ``one_process`` gives the
+smallest size rendered in this process, for the scaling); ``panels_per_s`` = B / seconds of one timed
 call, ``ms_per_decision`` its inverse in milliseconds. A backend that
 cannot run here is reported as ``null`` with the reason under ``skipped``.
 ``depth_agreement``: share of pixels where both backends see a surface
@@ -35,17 +37,27 @@ def _decision(r: ViewRenderer, poses: np.ndarray):
     return views
 
 
+def _timed(bank, sim, cfg, poses):
+    """One untimed warm-up decision, then one timed: (views, seconds)."""
+    with ViewRenderer(bank, sim, cfg) as r:
+        _decision(r, poses)
+        t0 = time.perf_counter()
+        views = _decision(r, poses)
+        return views, time.perf_counter() - t0
+
+
 def bench_render(bank, quick: bool) -> dict:
     """The ``render`` block (module docstring)."""
-    B = 8 if quick else 32
+    B = 16 if quick else 32
+    workers = ViewConfig(workers=0).worker_count()
     sizes = (224, 128) if quick else (448, 224, 128)
     rng = np.random.default_rng(0)
     free = bank.navgrids[0].navigable_points()
     xy = free[rng.choice(len(free), B, replace=len(free) < B)]
     poses = np.concatenate([xy, rng.uniform(-np.pi, np.pi, (B, 1))], 1).astype(np.float32)
     sim = SimConfig()
-    out = {"views": sim.n_views, "batch": B, "scene": bank.scene_ids[0], "panels_per_s": {}, "ms_per_decision": {},
-           "skipped": {}}
+    out = {"views": sim.n_views, "batch": B, "workers": workers, "scene": bank.scene_ids[0], "panels_per_s": {},
+           "ms_per_decision": {}, "skipped": {}, "one_process": {}}
     kept = {}
     for backend, why in (("warp", warp_available()), ("egl", egl_available())):
         for size in sizes:
@@ -54,14 +66,15 @@ def bench_render(bank, quick: bool) -> dict:
                 out["panels_per_s"][key] = out["ms_per_decision"][key] = None
                 out["skipped"][backend] = why
                 continue
-            with ViewRenderer(bank, sim, ViewConfig(size=size, backend=backend, fallback=False, worlds=B)) as r:
-                _decision(r, poses)
-                t0 = time.perf_counter()
-                views = _decision(r, poses)
-                dt = time.perf_counter() - t0
+            cfg = ViewConfig(size=size, backend=backend, fallback=False, worlds=B, workers=workers)
+            views, dt = _timed(bank, sim, cfg, poses)
             out["panels_per_s"][key] = B / dt
             out["ms_per_decision"][key] = 1000.0 * dt / B
-            log(f"  {key}: {B / dt:.2f} panels/s ({1000.0 * dt / B:.0f} ms a decision)")
+            log(f"  {key}: {B / dt:.2f} panels/s ({1000.0 * dt / B:.0f} ms a decision, {workers} workers)")
+            if workers > 1 and size == sizes[-1]:
+                _, dt1 = _timed(bank, sim, cfg.replace(workers=1), poses)
+                out["one_process"][key] = B / dt1
+                log(f"  {key} in one process: {B / dt1:.2f} panels/s")
             if size == sizes[0]:
                 kept[backend] = views
     if len(kept) == 2:

@@ -99,7 +99,7 @@ def test_quick_json_line():
     assert isinstance(res, dict)
     check_record(res)
     r = res["render"]
-    assert r["views"] == 8 and r["batch"] == 8
+    assert r["views"] == 8 and r["batch"] == 16 and r["workers"] >= 1
     assert set(r["panels_per_s"]) == {"warp@224", "warp@128", "egl@224", "egl@128"}
     for key, v in r["panels_per_s"].items():
         assert v is None or v > 0, key

@@ -60,6 +60,12 @@ class ViewConfig:
         quality: JPEG quality, 1..100.
         panel_grid: draw the 8x8 grid on every view of the Planner panel
             (the paper's panel carries local grids).
+        workers: render processes. MuJoCo Warp runs a kernel on one thread
+            when it runs on the CPU, and OpenGL renders one view at a time,
+            so on a CPU with C cores ``workers = C`` renders C calls at once
+            (each worker holds its own contexts; memory grows with it).
+            1 (default): render in this process. 0: one per CPU core this
+            process may use. Keep 1 on a GPU.
     """
 
     size: int = 448
@@ -71,6 +77,7 @@ class ViewConfig:
     image_format: str = "jpeg"
     quality: int = 90
     panel_grid: bool = True
+    workers: int = 1
 
     def __post_init__(self):
         def integer(name, lo, hi, why=""):
@@ -83,6 +90,7 @@ class ViewConfig:
         integer("memory_mb", 1, 1 << 20)
         integer("max_contexts", 1, 1024)
         integer("quality", 1, 100)
+        integer("workers", 0, 256, " (0: one per CPU core)")
         if self.backend not in BACKENDS:
             raise ConfigError(None, "views.backend", f"must be one of {', '.join(BACKENDS)}, got {self.backend!r}")
         if self.image_format not in FORMATS:
@@ -97,6 +105,15 @@ class ViewConfig:
             return self.worlds
         per_world = n_views * self.size * self.size * 16
         return max(1, min(1024, (self.memory_mb << 20) // per_world))
+
+    def worker_count(self) -> int:
+        """Render processes to use (``workers``; 0 resolved to the usable cores)."""
+        if self.workers:
+            return self.workers
+        try:
+            return max(1, len(os.sched_getaffinity(0)))
+        except AttributeError:  # not on Linux
+            return max(1, os.cpu_count() or 1)
 
     def replace(self, **kw) -> "ViewConfig":
         return dataclasses.replace(self, **kw)

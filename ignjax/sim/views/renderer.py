@@ -12,6 +12,8 @@ group with the configured backend:
   steps; memory therefore grows with ``max_contexts`` x worlds x N x S^2 x
   16 bytes, not with the scenes in the bank (:mod:`ignjax.sim.views.warp`).
 * egl: one OpenGL context per scene (a few MB each), one view at a time.
+* with ``ViewConfig.workers`` > 1 the calls go to that many worker
+  processes (:mod:`ignjax.sim.views.pool`), each with its own contexts.
 
 Poses are checked before anything is rendered (finite, inside the scene's
 bounds). The result, :class:`Views`, carries RGB, z-depth and instance
@@ -59,28 +61,26 @@ class Views:
         return int(self.rows.shape[0])
 
 
-class ViewRenderer:
-    """Batched egocentric views of the scenes of a bank.
+class SceneContexts:
+    """The backend's per-scene renderers, made on first use and kept in a
+    least-recently-used cache of ``config.max_contexts`` (closed when
+    dropped). Used in this process and, one each, in the render workers.
 
     Args:
-        bank: the scene bank (its compiled scenes are rendered).
-        sim: the simulator configuration (``n_views``, ``hfov``, ``eye_height``).
-        config: image size, backend and encoding (:class:`ViewConfig`).
+        compiled: ``compiled(s)`` gives scene ``s``'s :class:`~ignjax.scenes.compile.CompiledScene`.
+        backend: ``"warp"`` or ``"egl"`` (resolved).
     """
 
-    def __init__(self, bank: SceneBank, sim: SimConfig = SimConfig(), config: ViewConfig = ViewConfig()):
-        self.bank, self.sim, self.config = bank, sim, config
-        self.backend = resolve_backend(config)
-        self.n_views = sim.n_views
+    def __init__(self, compiled, backend: str, sim: SimConfig, config: ViewConfig):
+        self.compiled, self.backend, self.sim, self.config = compiled, backend, sim, config
         self._scenes: OrderedDict = OrderedDict()
 
-    # -- backends -------------------------------------------------------------
     def _scene(self, s: int, rows: int):
         cfg, sim = self.config, self.sim
         if self.backend == "egl":
             key = (s, 0)
         else:
-            limit = cfg.world_limit(self.n_views)
+            limit = cfg.world_limit(sim.n_views)
             key = (s, min(limit, 1 << max(0, int(rows - 1).bit_length())))
         if key in self._scenes:
             self._scenes.move_to_end(key)
@@ -90,21 +90,60 @@ class ViewRenderer:
             close = getattr(old, "close", None)
             if close:
                 close()
-        compiled = self.bank.compiled[s]
+        compiled = self.compiled(s)
         if self.backend == "egl":
             from ignjax.sim.views.egl import EglScene
 
-            r = EglScene(compiled, self.n_views, sim.hfov, sim.eye_height, cfg.size)
+            r = EglScene(compiled, sim.n_views, sim.hfov, sim.eye_height, cfg.size)
         else:
             from ignjax.sim.views.warp import WarpScene
 
-            r = WarpScene(compiled, self.n_views, sim.hfov, sim.eye_height, cfg.size, key[1])
+            r = WarpScene(compiled, sim.n_views, sim.hfov, sim.eye_height, cfg.size, key[1])
         self._scenes[key] = r
         return r
+
+    def render(self, s: int, poses: np.ndarray):
+        """(rgb, depth, instance) of the views of ``poses`` (R, 3) in scene
+        ``s``, R at most one call's rows (:meth:`ViewRenderer.render`)."""
+        return self._scene(s, poses.shape[0]).render(poses)
+
+    def close(self) -> None:
+        for r in self._scenes.values():
+            close = getattr(r, "close", None)
+            if close:
+                close()
+        self._scenes.clear()
+
+
+class ViewRenderer:
+    """Batched egocentric views of the scenes of a bank.
+
+    Args:
+        bank: the scene bank (its compiled scenes are rendered).
+        sim: the simulator configuration (``n_views``, ``hfov``, ``eye_height``).
+        config: image size, backend, workers and encoding (:class:`ViewConfig`).
+    """
+
+    def __init__(self, bank: SceneBank, sim: SimConfig = SimConfig(), config: ViewConfig = ViewConfig()):
+        self.bank, self.sim, self.config = bank, sim, config
+        self.backend = resolve_backend(config)
+        self.n_views = sim.n_views
+        self.workers = config.worker_count()
+        if self.workers > 1:
+            from ignjax.sim.views.pool import RenderPool
+
+            self._contexts = RenderPool(lambda s: bank.compiled[s], self.backend, sim, config, self.workers)
+        else:
+            self._contexts = SceneContexts(lambda s: bank.compiled[s], self.backend, sim, config)
 
     # -- rendering ------------------------------------------------------------
     def render(self, scene, poses, rows=None) -> Views:
         """Views of R rows given their scene indices (R,) and poses (R, 3).
+
+        Rows are grouped by scene and cut into calls of at most one
+        context's worlds (warp; all rows for OpenGL); with several workers
+        each group is cut into at least as many calls as there are workers,
+        and the calls run at once, one queue per worker.
 
         Raises:
             ConfigError: a scene index outside the bank or a pose outside
@@ -127,12 +166,17 @@ class ViewRenderer:
         rgb = np.empty((R, N, S, S, 3), np.uint8)
         depth = np.empty((R, N, S, S), np.float32)
         inst = np.empty((R, N, S, S), np.int32)
-        limit = R if self.backend == "egl" else self.config.world_limit(N)
+        calls = []
         for s, idx in groups:
-            for start in range(0, idx.size, limit):
-                part = idx[start:start + limit]
-                out = self._scene(s, part.size).render(poses[part])
-                rgb[part], depth[part], inst[part] = out
+            limit = idx.size if self.backend == "egl" else self.config.world_limit(N)
+            limit = max(1, min(limit, -(-idx.size // self.workers)))
+            calls += [(s, idx[start:start + limit]) for start in range(0, idx.size, limit)]
+        if self.workers > 1:
+            outs = self._contexts.render_many([(s, poses[part]) for s, part in calls])
+        else:
+            outs = (self._contexts.render(s, poses[part]) for s, part in calls)
+        for (_, part), out in zip(calls, outs):
+            rgb[part], depth[part], inst[part] = out
         return Views(rows=rows, scene=scene, pose=poses, rgb=rgb, depth=depth, instance=inst)
 
     def render_states(self, states: SimState, mask=None) -> Views:
@@ -160,11 +204,7 @@ class ViewRenderer:
         return grounder_images(views.rgb[np.arange(len(views)), direction])
 
     def close(self) -> None:
-        for r in self._scenes.values():
-            close = getattr(r, "close", None)
-            if close:
-                close()
-        self._scenes.clear()
+        self._contexts.close()
 
     def __enter__(self) -> "ViewRenderer":
         return self
@@ -173,4 +213,4 @@ class ViewRenderer:
         self.close()
 
 
-__all__ = ["ViewRenderer", "Views"]
+__all__ = ["SceneContexts", "ViewRenderer", "Views"]

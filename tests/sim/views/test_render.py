@@ -230,3 +230,21 @@ def test_oracle_visibility_matches_segmentation(house):
     print(f"oracle vs segmentation: {len(poses)} poses, oracle visible {said.sum()}, shown {shown.sum()}, "
           f"disagreement {disagreement:.3f} (shown, centre out of view: {np.sum(shown & ~said & ~in_view)}; "
           f"oracle visible, under 1% of the view: {np.sum(said & ~shown)})")
+
+
+def test_worker_processes_give_the_same_views(house, rendered):
+    """``ViewConfig.workers=2``: two render processes, the calls split
+    between them, the same arrays as rendering here; a killed worker fails
+    the next call with an error naming it instead of hanging."""
+    if "warp" not in rendered:
+        pytest.skip("needs the warp backend")
+    bank, poses = house
+    cfg = ViewConfig(size=SIZE, backend="warp", fallback=False, workers=2)
+    with ViewRenderer(bank, T.SimConfig(), cfg) as r:
+        assert r.workers == 2
+        v = r.render(np.zeros(POSES, int), poses)
+        for name in ("rgb", "depth", "instance"):
+            assert np.array_equal(getattr(v, name), getattr(rendered["warp"], name)), name
+        r._contexts._procs[1].kill()
+        with pytest.raises(RuntimeError, match="render worker 1"):
+            r.render(np.zeros(POSES, int), poses)
