@@ -24,6 +24,7 @@ The metrics can be recomputed from either outcome file alone
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import sys
 import time
@@ -38,11 +39,13 @@ from ignjax.protocol import LOCKED_COSTS, SUCCESS_THRESHOLDS
 def build_parser() -> argparse.ArgumentParser:
     # imported on use, so that --help and the other commands answer at once
     from ignjax.agents import registry
+    from ignjax.agents.llm.agent import LLM_AGENTS
 
     agents = registry()
     p = argparse.ArgumentParser(prog="python -m ignjax.evaluate", description=__doc__.split("\n\n")[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter,
-                                epilog="agents:\n" + "\n".join(f"  {a.name:14s} {a.description}" for a in agents.values()))
+                                epilog="agents:\n" + "\n".join(f"  {a.name:14s} {a.description}" for a in agents.values())
+                                + "".join(f"\n  {n:14s} {c.description}" for n, c in LLM_AGENTS.items()))
     p.add_argument("--episodes", required=True, help="episode file (.jsonl or .jsonl.gz) from `ignjax.build.cli episodes`")
     p.add_argument("--agent", action="append", required=True, help="agent name; repeat for several agents")
     p.add_argument("--out", default="runs/eval", help="output folder (default runs/eval)")
@@ -63,14 +66,30 @@ def build_parser() -> argparse.ArgumentParser:
                    help="sim.<key>=<value> (a simulator setting) or agents.<name>.<key>=<value> (an agent parameter); "
                         "values in TOML syntax; repeatable")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
+    p.add_argument("--limit", type=int, default=0, help="only the first N episodes of the file, for every agent")
+    g = p.add_argument_group("MLLM agents (" + ", ".join(sorted(LLM_AGENTS)) + "); settings also as --set llm.<key>=<value>"
+                             " and --set views.<key>=<value>")
+    g.add_argument("--llm-endpoint", action="append", default=[], metavar="URL",
+                   help="OpenAI-compatible base URL, e.g. http://127.0.0.1:8000/v1; repeat for several servers")
+    g.add_argument("--llm-model", help="the served model's name")
+    g.add_argument("--llm-key-env", default=None,
+                   help="environment variable holding the API key (default OPENAI_API_KEY; unset: no key sent)")
+    g.add_argument("--llm-cache", default=None, help="response cache folder (default OUT/llm_cache)")
+    g.add_argument("--llm-replay", action="store_true", help="answer from the cache only; a miss is an error naming "
+                                                             "the request's hash")
+    g.add_argument("--llm-concurrency", type=int, default=None, help="requests in flight per endpoint (default 16)")
+    g.add_argument("--llm-batch", type=int, default=64, help="episodes in flight at once (default 64)")
+    g.add_argument("--save-images", type=int, default=0, metavar="N",
+                   help="write the panels of the first N episodes to OUT/images (for python -m ignjax.view)")
     return p
 
 
-def parse_settings(items: list[str], agent_names: list[str]):
-    """``--set`` items -> (SimConfig, agent name -> parameter values).
+def parse_settings(items: list[str], agent_names: list[str], extra: tuple[str, ...] = ()):
+    """``--set`` items -> (SimConfig, agent name -> parameter values[, section -> values
+    for each section named in ``extra``, e.g. ``("llm", "views")``]).
 
     Raises:
-        ConfigError: a section other than ``sim`` / ``agents.<name>``, an
+        ConfigError: a section other than ``sim`` / ``agents.<name>`` / ``extra``, an
             unknown key, or a bad value (naming ``--set`` and the key).
     """
     from ignjax.agents import get_agent
@@ -79,23 +98,80 @@ def parse_settings(items: list[str], agent_names: list[str]):
 
     sim: dict = {}
     agents: dict[str, dict] = {}
+    sections: dict[str, dict] = {k: {} for k in extra}
     for item in items:
         name, value = parse_assignment(item, "--set")
         section, key = name.rsplit(".", 1)
         if section == "sim":
             sim[key] = value
+        elif section in sections:
+            sections[section][key] = value
         elif section.startswith("agents."):
             agent = get_agent(section.split(".", 1)[1])
             if agent.name not in agent_names:
                 raise ConfigError(None, "--set", f"{name}: agent {agent.name!r} is not evaluated (--agent)")
             agents.setdefault(agent.name, {})[key] = check_param_value(agent, key, value, "--set")
         else:
-            raise ConfigError(None, "--set", f"{name}: python -m ignjax.evaluate takes sim.<key> and "
-                                             f"agents.<name>.<key> (the other sections are the sweep's)")
+            allowed = ", ".join(["sim.<key>", "agents.<name>.<key>"] + [f"{k}.<key>" for k in extra])
+            raise ConfigError(None, "--set", f"{name}: python -m ignjax.evaluate takes {allowed} "
+                                             f"(the other sections are the sweep's)")
     try:
-        return SimConfig.from_values(sim), agents
+        cfg = SimConfig.from_values(sim)
     except ConfigError as e:
         raise ConfigError("--set", e.where, e.reason) from None
+    return (cfg, agents, sections) if extra else (cfg, agents)
+
+
+def llm_settings(args, sections: dict, out_dir: Path):
+    """The :class:`~ignjax.agents.llm.config.LLMConfig` and
+    :class:`~ignjax.sim.views.ViewConfig` of the MLLM agents from the
+    ``--llm-*`` flags and the ``--set llm.*`` / ``views.*`` items."""
+    from ignjax.agents.llm.config import LLMConfig
+    from ignjax.sim.views import ViewConfig
+
+    d = dict(sections.get("llm", {}))
+    if args.llm_endpoint:
+        d["endpoints"] = list(args.llm_endpoint)
+    if args.llm_model:
+        d["model"] = args.llm_model
+    if args.llm_key_env is not None:
+        d["api_key_env"] = args.llm_key_env
+    if args.llm_concurrency is not None:
+        d["concurrency"] = args.llm_concurrency
+    if args.llm_replay:
+        d["replay"] = True
+    d.setdefault("cache_dir", str(args.llm_cache or out_dir / "llm_cache"))
+    for need, flag in (("endpoints", "--llm-endpoint"), ("model", "--llm-model")):
+        if need not in d:
+            raise ConfigError(None, flag, "an MLLM agent needs the model server's base URL (--llm-endpoint) and the "
+                                          "served model's name (--llm-model)")
+    llm = LLMConfig.from_dict(d, where="--llm-*/--set llm")
+    v = {"size": 224, **sections.get("views", {})}
+    try:
+        views = ViewConfig(**v)
+    except TypeError as e:
+        raise ConfigError("--set", "views", str(e)) from None
+    return llm, views
+
+
+def model_totals(rows: list[dict], llm) -> dict[str, dict]:
+    """Per MLLM agent: the accounting columns summed over its episodes, the
+    episodes ended by model failure, and a cost estimate from ``llm.prices``
+    (USD per million prompt / completion tokens; None without prices)."""
+    from ignjax.agents.llm.client import price
+
+    out: dict[str, dict] = {}
+    for r in rows:
+        if not (r["requests"] or r["cache_hits"] or r["failure"]):
+            continue
+        t = out.setdefault(r["agent"], {"requests": 0, "cache_hits": 0, "prompt_tokens": 0, "completion_tokens": 0,
+                                        "retries": 0, "invalid_replies": 0, "failures": 0})
+        for k in ("requests", "cache_hits", "prompt_tokens", "completion_tokens", "retries", "invalid_replies"):
+            t[k] += int(r[k])
+        t["failures"] += int(bool(r["failure"]))
+    for t in out.values():
+        t["cost_usd"] = price(t["prompt_tokens"], t["completion_tokens"], llm.prices if llm else None)
+    return out
 
 
 def main(argv=None) -> int:
@@ -120,8 +196,16 @@ def run(args) -> int:
     from ignjax.evaluate.outcomes import (TRAJECTORY_FILE, metric_rows, outcome_rows, write_metric_table,
                                           write_outcomes, write_trajectories)
 
-    agents = [get_agent(a) for a in args.agent]
-    sim, agent_values = parse_settings(args.set, [a.name for a in agents])
+    from ignjax.agents.llm.agent import LLM_AGENTS, get_llm_agent
+    from ignjax.evaluate.hostloop import run_llm_agent, write_transcripts
+
+    agents = [get_llm_agent(a) if a in LLM_AGENTS else get_agent(a) for a in args.agent]
+    sim, agent_values, sections = parse_settings(args.set, [a.name for a in agents], ("llm", "views"))
+    out_dir = Path(args.out)
+    llm_agents = [a for a in agents if a.name in LLM_AGENTS]
+    llm, views = llm_settings(args, sections, out_dir) if llm_agents else (None, None)
+    if args.limit < 0:
+        raise ConfigError(None, "--limit", f"must be >= 0, got {args.limit}")
     thresholds = parse_floats(args.thresholds, 0, "--thresholds")
     costs = parse_floats(args.costs, 4, "--costs")
     if any(c < 0 for c in costs) or any(c != c for c in costs):
@@ -132,13 +216,29 @@ def run(args) -> int:
         raise ConfigError(None, "--parts", f"must be >= 0, got {args.parts}")
     t0 = time.perf_counter()
     es = load_benchmark(args.episodes, args.scenes_root)
+    if args.limit:
+        es = es.subset(range(min(args.limit, len(es))))
     world = make_world(es, sim)
     print(f"loaded {len(es)} episodes in {len(es.bank.scene_ids)} scenes ({time.perf_counter() - t0:.1f} s)", file=sys.stderr)
     rows = []
     trajectories = {}
     used: dict[str, dict] = {}
+    llm_stats = {}
     for agent in agents:
         t1 = time.perf_counter()
+        if agent.name in LLM_AGENTS:
+            res = run_llm_agent(es, agent, llm, sim=sim, views=views, batch=args.llm_batch, seed=args.seed, costs=costs,
+                                out=out_dir, save_images=args.save_images, progress=not args.quiet)
+            rows += outcome_rows(agent.name, es.records, res.outcomes, res.accounting)
+            trajectories[agent.name] = res.trajectories
+            write_transcripts(out_dir, agent.name, res.transcripts)
+            used[agent.name] = {"options": {k: v for k, v in vars(agent).items()}, "llm": llm.public_dict(),
+                                "views": dataclasses.asdict(views)}
+            llm_stats[agent.name] = res.stats
+            print(f"{agent.name}: {len(es)} episodes in {time.perf_counter() - t1:.1f} s, "
+                  f"{res.stats['requests']} requests sent ({res.stats['resumed']} episodes from an earlier run)",
+                  file=sys.stderr)
+            continue
         bar = (lambda it, name=agent.name: tqdm(it, desc=name, unit="batch", file=sys.stderr, disable=args.quiet, dynamic_ncols=True))
         # a cost-aware agent plans with the costs it is charged
         params = make_params(agent, agent_values.get(agent.name), costs=costs)
@@ -148,7 +248,6 @@ def run(args) -> int:
         rows += outcome_rows(agent.name, es.records, out)
         trajectories[agent.name] = traj
         print(f"{agent.name}: {len(es)} episodes in {time.perf_counter() - t1:.1f} s", file=sys.stderr)
-    out_dir = Path(args.out)
     p_parquet, p_csv = write_outcomes(rows, out_dir)
     metrics = metric_rows(rows, thresholds, costs, args.require_stop)
     write_metric_table(metrics, out_dir / "metrics.csv")
@@ -157,11 +256,17 @@ def run(args) -> int:
                        require_stop=args.require_stop, sim=sim.to_dict())
     run_record = {"episodes": str(args.episodes), "seed": args.seed, "batch": args.batch, "thresholds": list(thresholds),
                   "costs": list(costs), "require_stop": args.require_stop,
-                  "success_rule": M.success_rule(args.require_stop), "sim": sim.to_dict(), "agents": used}
+                  "success_rule": M.success_rule(args.require_stop), "sim": sim.to_dict(), "agents": used,
+                  "limit": args.limit, "model_totals": model_totals(rows, llm)}
     atomic_write(out_dir / "run.json", json.dumps(run_record, indent=2) + "\n")
     print(M.success_rule(args.require_stop))
     if all(t in thresholds for t in SUCCESS_THRESHOLDS):
         print(M.table1(metrics, "text"))
+    for name, totals in model_totals(rows, llm).items():
+        cost = f", estimated cost {totals['cost_usd']:.4f} USD" if totals["cost_usd"] is not None else ""
+        print(f"{name}: {totals['requests']} requests, {totals['cache_hits']} cache hits, "
+              f"{totals['prompt_tokens']} + {totals['completion_tokens']} tokens, {totals['retries']} retries, "
+              f"{totals['invalid_replies']} invalid replies, {totals['failures']} episodes ended by model failure{cost}")
     print(f"wrote {p_parquet}, {p_csv}, {out_dir / 'metrics.csv'}, {out_dir / TRAJECTORY_FILE} and "
           f"{out_dir / 'run.json'} (view the episodes: python -m ignjax.view {out_dir})")
     return 0

@@ -31,14 +31,19 @@ import numpy as np
 from ignjax.arrays import xp as _xp
 from ignjax.protocol import BIN_NAMES, LOCKED_COSTS, N_QUESTION_TYPES, SUCCESS_REQUIRES_STOP
 from ignjax.protocol import SUCCESS_THRESHOLDS as DEFAULT_THRESHOLDS
-from ignjax.sim.types import OutcomeRow
+from ignjax.sim.types import ABORTED, OutcomeRow
 
 
-def episode_success(final_distance, stopped, thresholds=DEFAULT_THRESHOLDS, require_stop: bool = SUCCESS_REQUIRES_STOP):
-    """(..., E, T) bool: 1{d <= tau} (and stopped, when required)."""
+def episode_success(final_distance, stopped, thresholds=DEFAULT_THRESHOLDS, require_stop: bool = SUCCESS_REQUIRES_STOP,
+                    stop_reason=None):
+    """(..., E, T) bool: 1{d <= tau} (and stopped, when required). With
+    ``stop_reason`` (..., E), an episode ended by a model failure
+    (:data:`~ignjax.sim.types.ABORTED`) is never a success."""
     xp = _xp(final_distance, stopped)
     d = xp.asarray(final_distance)[..., None]
     ok = d <= xp.asarray(thresholds, dtype=d.dtype)
+    if stop_reason is not None:
+        ok = ok & (xp.asarray(stop_reason) != ABORTED)[..., None]
     return ok & xp.asarray(stopped)[..., None] if require_stop else ok
 
 
@@ -101,7 +106,7 @@ def summarize(outcomes: OutcomeRow, thresholds=DEFAULT_THRESHOLDS, costs=LOCKED_
     xp = _xp(o.final_distance)
     fdt = np.float64 if xp is np else jnp.float32
     d = xp.asarray(o.final_distance, dtype=fdt)
-    succ = episode_success(d, o.stopped, thresholds, require_stop).astype(fdt)
+    succ = episode_success(d, o.stopped, thresholds, require_stop, o.stop_reason).astype(fdt)
     osucc = episode_success(xp.asarray(o.min_distance, dtype=fdt), o.stopped, thresholds, False).astype(fdt)
     wsr = episode_wsr(succ, o.n_questions, costs).astype(fdt)
     nq = xp.asarray(o.n_questions).astype(fdt)

@@ -56,8 +56,16 @@ from ignjax.sim.types import STOP_REASONS, OutcomeRow, Trajectory
 COLUMNS: tuple[str, ...] = (
     "agent", "episode_id", "scene_id", "difficulty", "final_distance", "final_euclidean", "min_distance",
     "path_length", "steps", "stopped", "stop_reason", "q1", "q2", "q3", "q4", "n_questions", "n_refused", "n_invalid",
-    "trace",
+    "trace", "requests", "cache_hits", "prompt_tokens", "completion_tokens", "retries", "invalid_replies",
+    "model_latency_s", "failure",
 )
+ACCOUNTING_COLUMNS: tuple[str, ...] = ("requests", "cache_hits", "prompt_tokens", "completion_tokens", "retries",
+                                       "invalid_replies", "model_latency_s", "failure")
+"""Model-call accounting of MLLM agents (:mod:`ignjax.evaluate.hostloop`): requests sent to a server (cache hits
+excluded), cache hits, tokens, HTTP retries, replies that could not be used, seconds spent waiting on the model in
+this run, and why an episode ended by model failure ("" otherwise). Zero (and "") for JAX-native agents; optional
+when a table is read (older tables have none)."""
+_ACCOUNTING_INTS = ("requests", "cache_hits", "prompt_tokens", "completion_tokens", "retries", "invalid_replies")
 
 
 def _trace(types, steps, charged) -> str:
@@ -75,9 +83,10 @@ def parse_trace(text: str) -> list[tuple[int, int, bool]]:
     return out
 
 
-def outcome_rows(agent: str, records: list[dict], out) -> list[dict]:
+def outcome_rows(agent: str, records: list[dict], out, accounting: dict | None = None) -> list[dict]:
     """Rows of an outcome table from a rollout's :class:`~ignjax.sim.types.OutcomeRow`
-    (numpy or JAX arrays with leading axis E matching ``records``)."""
+    (numpy or JAX arrays with leading axis E matching ``records``) and, for
+    MLLM agents, the per-episode ``accounting`` (:data:`ACCOUNTING_COLUMNS` -> (E,))."""
     o = {k: np.asarray(getattr(out, k)) for k in ("final_distance", "final_euclidean", "min_distance", "path_length",
                                                   "steps", "stopped", "stop_reason", "n_questions", "n_refused",
                                                   "n_invalid", "trace_type", "trace_step", "trace_charged")}
@@ -93,6 +102,9 @@ def outcome_rows(agent: str, records: list[dict], out) -> list[dict]:
             "q4": int(q[3]), "n_questions": int(q.sum()), "n_refused": int(o["n_refused"][k]),
             "n_invalid": int(o["n_invalid"][k]),
             "trace": _trace(o["trace_type"][k], o["trace_step"][k], o["trace_charged"][k]),
+            **{c: int(accounting[c][k]) if accounting else 0 for c in _ACCOUNTING_INTS},
+            "model_latency_s": float(accounting["model_latency_s"][k]) if accounting else 0.0,
+            "failure": str(accounting["failure"][k]) if accounting else "",
         })
     return rows
 
@@ -103,7 +115,9 @@ def _arrow_table(rows: list[dict]):
                         ("min_distance", pa.float64()), ("path_length", pa.float64()), ("steps", pa.int32()),
                         ("stopped", pa.bool_()), ("stop_reason", pa.string()), ("q1", pa.int32()), ("q2", pa.int32()),
                         ("q3", pa.int32()), ("q4", pa.int32()), ("n_questions", pa.int32()), ("n_refused", pa.int32()),
-                        ("n_invalid", pa.int32()), ("trace", pa.string())])
+                        ("n_invalid", pa.int32()), ("trace", pa.string()),
+                        *[(c, pa.int64()) for c in _ACCOUNTING_INTS], ("model_latency_s", pa.float64()),
+                        ("failure", pa.string())])
     return pa.Table.from_pylist(rows, schema=schema)
 
 
@@ -147,15 +161,24 @@ def read_outcomes(path: str | os.PathLike) -> list[dict]:
                     r[k] = float(r[k])
                 for k in ints:
                     r[k] = int(r[k])
+                for k in _ACCOUNTING_INTS:
+                    if k in r:
+                        r[k] = int(r[k])
+                if "model_latency_s" in r:
+                    r["model_latency_s"] = float(r["model_latency_s"])
                 r["stopped"] = r["stopped"] in ("True", "true", "1")
             except (KeyError, ValueError) as e:
                 raise InputError(p, f"line {i + 2}", f"bad or missing value: {e}") from e
     else:
         raise InputError(p, None, "expected a .parquet or .csv outcome table")
     if rows:
-        missing = [c for c in COLUMNS if c not in rows[0]]
+        missing = [c for c in COLUMNS if c not in rows[0] and c not in ACCOUNTING_COLUMNS]
         if missing:
             raise InputError(p, "columns", f"missing {missing}")
+        for r in rows:
+            for c in ACCOUNTING_COLUMNS:
+                if c not in r or r[c] is None:
+                    r[c] = "" if c == "failure" else 0.0 if c == "model_latency_s" else 0
     return rows
 
 

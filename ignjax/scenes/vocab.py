@@ -437,6 +437,14 @@ _COLOR_ALIASES = MappingProxyType(
 )
 
 
+def attribute_word(kind: int, code: int) -> str | None:
+    """The word of attribute ``kind`` (0 colour, 1 material, 2 size, 3 state,
+    the order of the simulator's attribute codes) with index ``code``; None
+    for -1 or an unknown code."""
+    words = (tuple(COLORS), MATERIALS, SIZES, STATES)[kind]
+    return words[code] if 0 <= code < len(words) else None
+
+
 def normalize_color(text: str | None) -> str | None:
     """Map a colour word onto :data:`COLORS` (``grey`` -> ``gray``); None if unknown."""
     if not text:

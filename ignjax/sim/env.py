@@ -123,10 +123,11 @@ def reset(world: World, episode: T.EpisodeSpec, key: jax.Array | None = None) ->
 # ---------------------------------------------------------------------------
 
 
-def sanitize_action(action: T.Action) -> tuple[T.Action, jax.Array]:
-    """Clamp an action into range; returns (clamped action, was_invalid)."""
+def sanitize_action(action: T.Action, n_views: int = T.N_VIEWS) -> tuple[T.Action, jax.Array]:
+    """Clamp an action into range (direction: view 0..n_views-1); returns
+    (clamped action, was_invalid)."""
     kind = jnp.clip(action.kind, 0, 2)
-    d = jnp.clip(action.direction, 0, 7)
+    d = jnp.clip(action.direction, 0, n_views - 1)
     c = jnp.clip(action.col, 1, 8)
     r = jnp.clip(action.row, 1, 8)
     q = jnp.clip(action.question, 1, 4)
@@ -143,7 +144,7 @@ def step_batch(world: World, states: T.SimState, actions: T.Action, chunk: int |
     :func:`ignjax.sim.compact.masked_map`)."""
     with jax.named_scope("sim_step"):
         cfg = world.config
-        act, bad = jax.vmap(sanitize_action)(actions)
+        act, bad = jax.vmap(lambda a: sanitize_action(a, cfg.n_views))(actions)
         live = ~states.done
         is_move = (act.kind == T.MOVE) & live
         is_ask = (act.kind == T.ASK) & live
@@ -218,14 +219,15 @@ def privileged_info(world: World, state: T.SimState) -> T.Privileged:
 # ---------------------------------------------------------------------------
 
 
-def check_action(action: T.Action) -> None:
-    """Reject out-of-range actions at the API boundary (host side).
+def check_action(action: T.Action, n_views: int = T.N_VIEWS) -> None:
+    """Reject out-of-range actions at the API boundary (host side); a MOVE's
+    direction is a view 0..n_views-1.
 
     Raises:
         ConfigError: naming the field and the allowed range.
     """
     a = jax.tree.map(np.asarray, action)
-    for name, lo, hi in (("kind", 0, 2), ("direction", 0, 7), ("col", 1, 8), ("row", 1, 8), ("question", 1, 4)):
+    for name, lo, hi in (("kind", 0, 2), ("direction", 0, n_views - 1), ("col", 1, 8), ("row", 1, 8), ("question", 1, 4)):
         v = getattr(a, name)
         if np.any((v < lo) | (v > hi)):
             raise ConfigError(None, f"action.{name}", f"must lie in {lo}..{hi}, got {v.tolist()}")

@@ -105,6 +105,27 @@ def refused_text() -> str:
     return "You have no questions left; keep searching on your own."
 
 
+def answer_text(question: int, refused: bool, *, appearance: str, region: str, hint_room_label: int = -1,
+                hint_sector: int = 0, hint_landmark: int = -1, hint_in_room: bool = False, confirm: int = -1,
+                follow_up: int = 0, categories: tuple[str, ...] = (), key: str = "") -> str:
+    """The oracle's answer to one question of type ``question`` (1..4) in
+    words, from the episode's texts (Type 1: its description, Type 2: its
+    goal region) and the answer's array facts (Types 3 and 4); the refusal
+    when the question was refused. ``key`` varies the wording
+    deterministically (episode id and step)."""
+    if refused:
+        return refused_text()
+    if question == 1:
+        return appearance_text(appearance)
+    if question == 2:
+        return region_text(region)
+    if question == 3:
+        return route_text(hint_room_label, hint_sector, hint_landmark, hint_in_room, categories, key)
+    if question == 4:
+        return confirm_text(confirm, follow_up, key)
+    return ""
+
+
 def hint_progress_text(progress: int) -> str:
     """Qualitative progress report of an active Type-3 hint after a step."""
     return HINT_PROGRESS_TEXT.get(int(progress), "")

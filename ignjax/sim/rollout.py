@@ -46,7 +46,8 @@ from ignjax.sim.compact import chunk_size, even_chunk, first_equal, masked_map
 from ignjax.sim.world import World
 
 
-def step_record(obs: T.Observation, action: T.Action, kind, before: T.SimState, after: T.SimState) -> tuple:
+def step_record(obs: T.Observation, action: T.Action, kind, before: T.SimState, after: T.SimState,
+                n_views: int = T.N_VIEWS) -> tuple:
     """One step's entry of the :class:`~ignjax.sim.types.Trajectory`, for one
     episode or a batch (leading axes alike): the observation the agent
     decided on, its action, the kind recorded (-1 once the episode had
@@ -60,7 +61,7 @@ def step_record(obs: T.Observation, action: T.Action, kind, before: T.SimState, 
     a = after.answers
     candidate = jnp.where(is_ask & (q == 4), action.candidate, -1).astype(i32)
     waypoint = jnp.where(is_move[..., None], after.waypoint, before.pose[..., :2])
-    return (kind.astype(i32), q, on_move(action.direction, 0, 7), on_move(action.col, 1, 8),
+    return (kind.astype(i32), q, on_move(action.direction, 0, n_views - 1), on_move(action.col, 1, 8),
             on_move(action.row, 1, 8), candidate, waypoint, after.blocked & is_move[..., None],
             is_ask & a.refused, after.n_questions, a.confirm, a.follow_up, a.hint_room_label, a.hint_sector,
             a.hint_landmark, a.hint_in_room, a.hint_progress, obs.room_label, obs.visible_handle,

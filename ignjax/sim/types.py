@@ -33,8 +33,10 @@ from ignjax.errors import ConfigError
 
 MOVE, ASK, STOP = 0, 1, 2
 ACTION_KINDS = ("move", "ask", "stop")
-RUNNING, STOPPED, OUT_OF_STEPS = 0, 1, 2
-STOP_REASONS = ("running", "stop", "step_budget")
+RUNNING, STOPPED, OUT_OF_STEPS, ABORTED = 0, 1, 2, 3
+STOP_REASONS = ("running", "stop", "step_budget", "model_failure")
+"""How an episode ended; ``model_failure``: an MLLM agent's requests kept
+failing and the host loop ended the episode (it counts as a failure)."""
 HINT_NONE, HINT_CLOSER, HINT_SAME, HINT_FARTHER, HINT_REACHED, HINT_STOP = 0, 1, 2, 3, 4, 5
 HINT_PROGRESS = ("none", "closer", "no_change", "farther", "reached", "stop_eligible")
 FOLLOW_NONE, FOLLOW_STOP_NOW, FOLLOW_ONE_MOVE = 0, 1, 2

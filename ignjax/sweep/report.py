@@ -63,7 +63,8 @@ def agent_arrays(es, rollouts: dict, cfg: SweepConfig) -> dict:
     outs = [rollouts[a]["out"] for a in names]
     fd = np.stack([np.asarray(o["final_distance"]) for o in outs])
     stopped = np.stack([np.asarray(o["stopped"]) for o in outs])
-    success = np.asarray(M.episode_success(fd, stopped, tuple(cfg.eval.thresholds), cfg.eval.require_stop))
+    reason = np.stack([np.asarray(o["stop_reason"]) for o in outs]) if all("stop_reason" in o for o in outs) else None
+    success = np.asarray(M.episode_success(fd, stopped, tuple(cfg.eval.thresholds), cfg.eval.require_stop, reason))
     nq = np.stack([np.asarray(o["n_questions"]) for o in outs]).astype(np.int64)
     difficulty = np.array([BIN_INDEX[r["difficulty"]] for r in es.records], np.int64)
     return {"names": names, "success": success, "n_questions": nq, "valid": np.ones(fd.shape, bool),

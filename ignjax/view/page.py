@@ -48,19 +48,16 @@ IMAGE_MIME = {".jpg": "image/jpeg", ".jpeg": "image/jpeg", ".png": "image/png"}
 
 def _answer_text(rec: dict, t: int, q: int, tr: dict, i: int, categories: tuple[str, ...]) -> str:
     """The oracle's answer to the ASK of step ``t`` (type ``q``) in words."""
-    if "refused" in tr and bool(tr["refused"][i, t]):
-        return OT.refused_text()
-    key = f"{rec['episode_id']}:{t}"
-    if q == 1:
-        return OT.appearance_text(rec["oracle"]["appearance"])
-    if q == 2:
-        return OT.region_text(rec["oracle"]["region"])
-    if q == 3 and "hint_sector" in tr:
-        return OT.route_text(int(tr["hint_room_label"][i, t]), int(tr["hint_sector"][i, t]),
-                             int(tr["hint_landmark"][i, t]), bool(tr["hint_in_room"][i, t]), categories, key)
-    if q == 4 and "confirm" in tr:
-        return OT.confirm_text(int(tr["confirm"][i, t]), int(tr["follow_up"][i, t]), key)
-    return ""
+    if (q == 3 and "hint_sector" not in tr) or (q == 4 and "confirm" not in tr):
+        return ""
+    facts = {}
+    if q == 3:
+        facts = dict(hint_room_label=int(tr["hint_room_label"][i, t]), hint_sector=int(tr["hint_sector"][i, t]),
+                     hint_landmark=int(tr["hint_landmark"][i, t]), hint_in_room=bool(tr["hint_in_room"][i, t]))
+    elif q == 4:
+        facts = dict(confirm=int(tr["confirm"][i, t]), follow_up=int(tr["follow_up"][i, t]))
+    return OT.answer_text(q, "refused" in tr and bool(tr["refused"][i, t]), appearance=rec["oracle"]["appearance"],
+                          region=rec["oracle"]["region"], categories=categories, key=f"{rec['episode_id']}:{t}", **facts)
 
 
 def _data_uri(path: Path) -> str:
@@ -89,7 +86,7 @@ def run_entry(run: Run, agent: str, i: int, rec: dict, truth: list[list[int]]) -
     n = min(int(row["steps"]), tr["kind"].shape[1])
     q = [int(row[f"q{t}"]) for t in range(1, 5)]
     succ = M.episode_success(np.array([row["final_distance"]]), np.array([row["stopped"]]), tuple(meta["thresholds"]),
-                             bool(meta["require_stop"]))[0]
+                             bool(meta["require_stop"]), np.array([T.STOP_REASONS.index(row["stop_reason"])]))[0]
     pose = tr["pose"][i, : n + 1]
     kind = [int(k) for k in tr["kind"][i, :n]]
     qt = [int(v) for v in tr["question"][i, :n]]

@@ -5,7 +5,7 @@ on the CPU (its CPU path is a sequential loop and not safe to launch from
 several threads at once), and OpenGL renders one view at a time, so one
 process renders on one core whatever the machine has. A pool of
 ``ViewConfig.workers`` processes, each holding its own
-:class:`~ignjax.sim.views.renderer.SceneContexts`, renders that many calls
+:class:`~ignjax.sim.views.contexts.SceneContexts`, renders that many calls
 at once.
 
 Protocol (one duplex pipe per worker, driven by one parent thread per
@@ -43,7 +43,7 @@ import numpy as np
 
 def _serve(conn) -> None:
     """A worker's loop: first message ``("init", backend, sim, config)``."""
-    from ignjax.sim.views.renderer import SceneContexts
+    from ignjax.sim.views.contexts import SceneContexts
 
     _, backend, sim, config = conn.recv()
     compiled: dict = {}

@@ -25,7 +25,6 @@ turns them into PNG/JPEG bytes.
 
 from __future__ import annotations
 
-from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,6 +34,7 @@ from ignjax.scenes.bank import SceneBank
 from ignjax.sim.types import SimConfig, SimState
 from ignjax.sim.views.cameras import check_poses
 from ignjax.sim.views.config import ViewConfig, resolve_backend
+from ignjax.sim.views.contexts import MIN_WORLDS, SceneContexts
 
 
 @dataclass(frozen=True)
@@ -59,60 +59,6 @@ class Views:
 
     def __len__(self) -> int:
         return int(self.rows.shape[0])
-
-
-class SceneContexts:
-    """The backend's per-scene renderers, made on first use and kept in a
-    least-recently-used cache of ``config.max_contexts`` (closed when
-    dropped). Used in this process and, one each, in the render workers.
-
-    Args:
-        compiled: ``compiled(s)`` gives scene ``s``'s :class:`~ignjax.scenes.compile.CompiledScene`.
-        backend: ``"warp"`` or ``"egl"`` (resolved).
-    """
-
-    def __init__(self, compiled, backend: str, sim: SimConfig, config: ViewConfig):
-        self.compiled, self.backend, self.sim, self.config = compiled, backend, sim, config
-        self._scenes: OrderedDict = OrderedDict()
-
-    def _scene(self, s: int, rows: int):
-        cfg, sim = self.config, self.sim
-        if self.backend == "egl":
-            key = (s, 0)
-        else:
-            limit = cfg.world_limit(sim.n_views)
-            key = (s, min(limit, 1 << max(0, int(rows - 1).bit_length())))
-        if key in self._scenes:
-            self._scenes.move_to_end(key)
-            return self._scenes[key]
-        while len(self._scenes) >= cfg.max_contexts:
-            _, old = self._scenes.popitem(last=False)
-            close = getattr(old, "close", None)
-            if close:
-                close()
-        compiled = self.compiled(s)
-        if self.backend == "egl":
-            from ignjax.sim.views.egl import EglScene
-
-            r = EglScene(compiled, sim.n_views, sim.hfov, sim.eye_height, cfg.size)
-        else:
-            from ignjax.sim.views.warp import WarpScene
-
-            r = WarpScene(compiled, sim.n_views, sim.hfov, sim.eye_height, cfg.size, key[1])
-        self._scenes[key] = r
-        return r
-
-    def render(self, s: int, poses: np.ndarray):
-        """(rgb, depth, instance) of the views of ``poses`` (R, 3) in scene
-        ``s``, R at most one call's rows (:meth:`ViewRenderer.render`)."""
-        return self._scene(s, poses.shape[0]).render(poses)
-
-    def close(self) -> None:
-        for r in self._scenes.values():
-            close = getattr(r, "close", None)
-            if close:
-                close()
-        self._scenes.clear()
 
 
 class ViewRenderer:
@@ -213,4 +159,4 @@ class ViewRenderer:
         self.close()
 
 
-__all__ = ["SceneContexts", "ViewRenderer", "Views"]
+__all__ = ["MIN_WORLDS", "SceneContexts", "ViewRenderer", "Views"]

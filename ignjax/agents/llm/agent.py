@@ -1,0 +1,268 @@
+"""Agents driven by a multimodal model: what they read, what they may reply,
+and the single-stage ``vlm`` agent.
+
+An MLLM agent runs on the host, between the simulator's jitted steps
+(:mod:`ignjax.evaluate.hostloop`). At each decision the loop gives it a
+:class:`Decision` (everything the agent may read, all of it allowed to the
+paper's Planner: the instruction, the remaining budgets, the question costs,
+the oracle's answers so far as text, the executor's feedback on the last
+move, and the Planner panel or a text rendering of the symbolic
+observation). The agent turns it into a :class:`~ignjax.agents.llm.client.ChatRequest`,
+and the model's reply into an action. Nothing the paper withholds from the
+Planner (world coordinates, path lengths, compass headings, target
+distances) is in a :class:`Decision`.
+
+The reply is one JSON object (:func:`decision_schema`)::
+
+    {"action": "move" | "ask" | "stop",
+     "direction": view index 0..N-1 (MOVE: the view to move in),
+     "col": 1..8, "row": 1..8      (MOVE: the grid cell on that view;
+                                    columns left to right, rows bottom to top),
+     "question": 1..4              (ASK: the question type),
+     "reason": short free text}
+
+Every key is required (a schema-constrained server always fills them); the
+keys an action does not use are ignored. A reply that does not parse, breaks
+the schema or names a value out of range is answered with a short
+correction and asked again (``reasks`` times); after that the agent takes
+its default action (:meth:`LLMAgent.default_action`: a short move straight
+ahead, the cell at column 4, row 1) and the reply counts as invalid.
+
+The prompts are ours; they follow the paper's structure (role and task,
+action rules, the grid convention, the question types and their costs, the
+reply format; then the step's state and images).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ignjax.agents.llm.client import ChatRequest, ImagePart
+from ignjax.sim.views.compose import view_names
+
+MOVE, ASK, STOP = 0, 1, 2
+"""Action kinds (the values of :data:`ignjax.sim.types.MOVE` etc.)."""
+
+QUESTION_NAMES = {1: "appearance", 2: "region", 3: "route", 4: "confirmation"}
+QUESTION_HELP = {
+    1: "what the target looks like (colour, material, size, state, what it stands on or near)",
+    2: "which room the target is in and what it is near",
+    3: "which way to go from here (a coarse route hint toward the goal)",
+    4: "whether the object straight in front of you is the target",
+}
+
+
+def decision_schema(n_views: int) -> dict:
+    """JSON schema of one decision (module docstring)."""
+    i = lambda lo, hi: {"type": "integer", "minimum": lo, "maximum": hi}  # noqa: E731
+    return {
+        "type": "object",
+        "properties": {
+            "action": {"type": "string", "enum": ["move", "ask", "stop"]},
+            "direction": i(0, n_views - 1),
+            "col": i(1, 8),
+            "row": i(1, 8),
+            "question": i(1, 4),
+            "reason": {"type": "string", "maxLength": 200},
+        },
+        "required": ["action", "direction", "col", "row", "question", "reason"],
+        "additionalProperties": False,
+    }
+
+
+@dataclass(frozen=True)
+class Decision:
+    """Everything an MLLM agent may read at one decision.
+
+    Attributes:
+        episode: the episode id (for the request's tag).
+        step: planner steps taken so far (0-based index of this decision).
+        max_steps: the step budget.
+        goal: the instruction's object ("laptop").
+        questions_left: questions the agent may still ask.
+        costs: the four question types' costs (the cost-aware setting shows them).
+        answers: the oracle's answers so far, in order, as ``(type, text)``.
+        last_move: what the executor reported about the last MOVE ("" at the start).
+        n_views: views in the panel.
+        panel: the Planner panel, encoded (None for text observations).
+        observation: the symbolic observation as text (None with a panel).
+    """
+
+    episode: str
+    step: int
+    max_steps: int
+    goal: str
+    questions_left: int
+    costs: tuple[float, ...]
+    answers: tuple[tuple[int, str], ...]
+    last_move: str
+    n_views: int
+    panel: ImagePart | None = None
+    observation: str | None = None
+
+
+@dataclass
+class EpisodeMemory:
+    """What an agent keeps across one episode's decisions (host side)."""
+
+    history: list = field(default_factory=list)
+
+
+class LLMAgent:
+    """Base of the agents the host loop drives.
+
+    Attributes:
+        name: registry name.
+        description: one line for ``--help``.
+        observation: ``"panel"`` (rendered images) or ``"text"``.
+        reasks: corrections before the default action.
+        show_costs: the prompt lists the question costs (the cost-aware setting).
+        may_ask: the agent may ask questions at all.
+    """
+
+    name = "llm"
+    description = ""
+    observation = "panel"
+    reasks = 2
+    show_costs = True
+    may_ask = True
+
+    def start(self, episode: str) -> EpisodeMemory:
+        return EpisodeMemory()
+
+    def request(self, memory: EpisodeMemory, d: Decision) -> ChatRequest:
+        raise NotImplementedError
+
+    def correction(self, memory: EpisodeMemory, d: Decision, previous: ChatRequest, reply: str, error: str) -> ChatRequest:
+        """The same request with the faulty reply and a short correction appended."""
+        msgs = list(previous.messages) + [
+            {"role": "assistant", "content": reply or "(empty reply)"},
+            {"role": "user", "content": f"That reply cannot be used: {error}. Answer again with one JSON object "
+                                        "that follows the format exactly."},
+        ]
+        return ChatRequest(messages=msgs, schema=previous.schema, schema_name=previous.schema_name, tag=previous.tag)
+
+    def action(self, memory: EpisodeMemory, d: Decision, parsed: dict | None, error: str | None):
+        """``(kind, direction, col, row, question)`` from a parsed reply, or
+        ``(None, reason)`` when it cannot be used."""
+        if parsed is None:
+            return None, error or "the reply is not a JSON object"
+        a = parsed.get("action")
+        if a not in ("move", "ask", "stop"):
+            return None, "field 'action' must be one of move, ask, stop"
+
+        def integer(name, lo, hi):
+            v = parsed.get(name)
+            if isinstance(v, bool) or not isinstance(v, int) or not lo <= v <= hi:
+                raise ValueError(f"field '{name}' must be an integer from {lo} to {hi}")
+            return v
+
+        try:
+            if a == "move":
+                act = (MOVE, integer("direction", 0, d.n_views - 1), integer("col", 1, 8), integer("row", 1, 8), 1)
+            elif a == "ask":
+                if not self.may_ask:
+                    return None, "this agent may not ask questions; choose move or stop"
+                act = (ASK, 0, 4, 1, integer("question", 1, 4))
+            else:
+                act = (STOP, 0, 4, 1, 1)
+        except ValueError as e:
+            return None, str(e)
+        memory.history.append((d.step, a, act, str(parsed.get("reason", ""))[:120]))
+        return act, None
+
+    def default_action(self, memory: EpisodeMemory, d: Decision):
+        """The safe action after the re-asks are spent: a short move straight ahead."""
+        act = (MOVE, 0, 4, 1, 1)
+        memory.history.append((d.step, "move", act, "(default after invalid replies)"))
+        return act
+
+
+def _history_text(memory: EpisodeMemory, names, limit: int = 6) -> str:
+    lines = []
+    for step, a, act, reason in memory.history[-limit:]:
+        if a == "move":
+            lines.append(f"step {step}: moved toward the {names[act[1]]} view, cell column {act[2]} row {act[3]}")
+        elif a == "ask":
+            lines.append(f"step {step}: asked a {QUESTION_NAMES[act[4]]} question")
+    return "\n".join(lines) if lines else "(none yet)"
+
+
+class VlmAgent(LLMAgent):
+    """``vlm``: one request per decision (single stage, no memory beyond
+    the recent moves): the instruction, the Planner panel (or the text
+    observation), the answers so far, the budgets; the reply is one JSON
+    decision (module docstring)."""
+
+    name = "vlm"
+    description = "single-stage MLLM agent: one request per decision with the panel, answers and budgets"
+
+    def __init__(self, observation: str = "panel", reasks: int = 2, show_costs: bool = True):
+        if observation not in ("panel", "text"):
+            raise ValueError(f"observation must be 'panel' or 'text', got {observation!r}")
+        self.observation, self.reasks, self.show_costs = observation, int(reasks), bool(show_costs)
+
+    def system_text(self, d: Decision) -> str:
+        names = view_names(d.n_views)
+        views = ", ".join(f"{k} = {n}" for k, n in enumerate(names))
+        qs = "\n".join(f"  {t} ({QUESTION_NAMES[t]}): {QUESTION_HELP[t]}"
+                       + (f"; costs {d.costs[t - 1]:.3f}" if self.show_costs else "") for t in range(1, 5))
+        see = ("a panel of the views around you, each labelled with its name and covered by a numbered 8x8 grid"
+               if self.observation == "panel" else "a text list of what each view around you shows")
+        return (
+            "You control a robot in a house. Your task is to find one particular object and stop next to it. "
+            "Several objects of the same kind may be present; only one is the target.\n"
+            f"Each turn you see {see}. Views are numbered counter-clockwise: {views}.\n"
+            "Each turn choose exactly one action:\n"
+            "- move: pick a view (direction) and a cell of its grid to walk toward. Columns 1-8 run left to right, "
+            "rows 1-8 run bottom to top; rows 1-3 are the floor in front of you, higher rows lie further away.\n"
+            "- ask: put one question to a helper who knows where the target is. Question types:\n"
+            f"{qs}\n"
+            "  Every question lowers your final score" + (" by its cost" if self.show_costs else "")
+            + ", so ask only when the answer will change what you do.\n"
+            "- stop: end the episode when you are next to the target (within about a metre and a half).\n"
+            "Reply with one JSON object and nothing else: "
+            '{"action": "move"|"ask"|"stop", "direction": <view number>, "col": <1-8>, "row": <1-8>, '
+            '"question": <1-4>, "reason": "<a few words>"}. Fill every key; keys your action does not use are ignored.'
+        )
+
+    def state_text(self, memory: EpisodeMemory, d: Decision) -> str:
+        answers = "\n".join(f"- ({QUESTION_NAMES[t]}) {text}" for t, text in d.answers) or "(no questions asked yet)"
+        parts = [
+            f"Find the {d.goal}.",
+            f"Turn {d.step + 1} of at most {d.max_steps}. Questions left: {d.questions_left}.",
+            f"What the helper has told you:\n{answers}",
+            f"Your recent actions:\n{_history_text(memory, view_names(d.n_views))}",
+        ]
+        if d.last_move:
+            parts.append(f"Last move: {d.last_move}")
+        if self.observation == "text":
+            parts.append(f"What you see:\n{d.observation}")
+        else:
+            parts.append("The panel of your views follows.")
+        return "\n\n".join(parts)
+
+    def request(self, memory: EpisodeMemory, d: Decision) -> ChatRequest:
+        content: list = [self.state_text(memory, d)]
+        if self.observation == "panel":
+            if d.panel is None:
+                raise ValueError("the vlm agent reads the panel, but the decision carries none")
+            content.append(d.panel)
+        return ChatRequest(messages=[{"role": "system", "content": self.system_text(d)},
+                                     {"role": "user", "content": content}],
+                           schema=decision_schema(d.n_views), tag=d.episode)
+
+
+LLM_AGENTS = {"vlm": VlmAgent}
+"""Registry of MLLM agents by name (built by the host loop with keyword options)."""
+
+
+def get_llm_agent(name: str, **options) -> LLMAgent:
+    """The MLLM agent ``name`` (:data:`LLM_AGENTS`) with its options."""
+    if name not in LLM_AGENTS:
+        raise KeyError(name)
+    return LLM_AGENTS[name](**options)
+
+
+__all__ = ["ASK", "Decision", "EpisodeMemory", "LLMAgent", "LLM_AGENTS", "MOVE", "QUESTION_NAMES", "STOP", "VlmAgent",
+           "decision_schema", "get_llm_agent"]

@@ -1,0 +1,580 @@
+"""The host loop of MLLM agents: batched asynchronous model calls between
+jitted simulator steps.
+
+All live episodes step together. The loop keeps ``batch`` slots; each holds
+one episode. A round:
+
+1. the jitted step runs for the rows whose decision has arrived (the other
+   rows are left as they are: a row that waits never blocks a row that is
+   ready), and records each stepped row's trajectory entry;
+2. rows whose episode ended are written out (outcome, trajectory, transcript,
+   accounting: one checkpoint line each) and refilled from the queue of
+   remaining episodes (continuous batching on our side, so the server stays
+   busy);
+3. for the rows that need a decision, the jitted observation, then (in a
+   worker thread, while the other rows' requests stay in flight) the views
+   are rendered and the Planner panels composed and encoded
+   (:class:`~ignjax.sim.views.ViewRenderer`), and one request per row is
+   sent; all requests are in flight at once, bounded per endpoint by the
+   client (:class:`~ignjax.agents.llm.client.ChatClient`);
+4. the loop wakes when any reply arrives and takes every reply that has
+   arrived by then.
+
+Bad replies: a reply that does not parse or names an out-of-range value is
+answered with a short correction and asked again (``agent.reasks`` times),
+then the agent's default action is taken and the reply counted in
+``invalid_replies``. Requests that keep failing (the client's retry caps
+spent) end that episode with stop reason ``model_failure`` and the reason in
+``failure``; the other episodes continue. A cache miss under replay ends the
+run with the request's hash.
+
+Resume: every finished episode is appended to ``<out>/llm/<agent>.progress.jsonl``
+(flushed and synced). A run started again with the same settings skips the
+episodes found there and re-runs the others from their start; their earlier
+requests come from the response cache (no request sent twice, no question
+charged twice: the simulator replays the same decisions), so the outcomes
+equal an uninterrupted run. A file written with other settings is refused.
+
+Determinism: an episode's course depends on its episode, its key (seed and
+index in the file), the simulator and the replies; not on its slot, the
+batch size or the order replies arrive in. Transcripts are written at the
+end sorted by episode and step.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import dataclasses
+import hashlib
+import json
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from ignjax.agents.llm.agent import ASK, MOVE, Decision, LLMAgent, QUESTION_NAMES
+from ignjax.agents.llm.cache import ResponseCache
+from ignjax.agents.llm.client import ChatClient, ImagePart, LLMRequestError
+from ignjax.agents.llm.config import LLMConfig
+from ignjax.episodes.dataset import EpisodeSet
+from ignjax.errors import ConfigError, InputError
+from ignjax.evaluate.outcomes import ACCOUNTING_COLUMNS
+from ignjax.fileio import atomic_write
+from ignjax.protocol import LOCKED_COSTS
+from ignjax.scenes import vocab
+from ignjax.sim import env as E
+from ignjax.sim import oracle_text as OT
+from ignjax.sim import types as T
+from ignjax.sim.rollout import episode_keys, step_record
+from ignjax.sim.views import ViewConfig
+
+ACCOUNTING = tuple(c for c in ACCOUNTING_COLUMNS if c != "failure")
+"""Per-episode counters of an MLLM agent (:data:`ignjax.evaluate.outcomes.ACCOUNTING_COLUMNS`;
+``failure`` is kept beside them as text)."""
+
+
+@dataclass
+class _Episode:
+    index: int
+    memory: object
+    answers: list = field(default_factory=list)
+    calls: list = field(default_factory=list)
+    acc: dict = field(default_factory=lambda: {k: 0 for k in ACCOUNTING})
+    failure: str = ""
+    progress: str = ""
+    images: list = field(default_factory=list)
+
+
+@dataclass
+class LoopResult:
+    """What :func:`run_llm_agent` returns (episodes in file order).
+
+    Attributes:
+        outcomes: :class:`~ignjax.sim.types.OutcomeRow` of numpy arrays (E,).
+        trajectories: :class:`~ignjax.sim.types.Trajectory` of numpy arrays (E, ...).
+        accounting: column name -> (E,) array (:data:`ACCOUNTING`), plus ``failure`` (list of str).
+        stats: run totals: wall time, decisions, utilisation, requests in flight.
+        transcripts: the transcript records (viewer schema plus request hash,
+            image hashes, tokens, latency, cache hit), sorted by episode and step.
+    """
+
+    outcomes: T.OutcomeRow
+    trajectories: T.Trajectory
+    accounting: dict
+    stats: dict
+    transcripts: list
+
+
+def _settings_hash(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, sim: T.SimConfig, views: ViewConfig, seed: int,
+                   costs) -> str:
+    blob = json.dumps({"episodes": es.episode_ids, "agent": agent.name, "agent_options": vars(agent),
+                       "llm": {k: v for k, v in llm.public_dict().items() if k not in ("endpoints", "concurrency",
+                                                                                         "cache_dir", "replay")},
+                       "sim": sim.to_dict(), "views": dataclasses.asdict(views.replace(workers=1)), "seed": seed,
+                       "costs": [float(c) for c in costs]}, sort_keys=True, default=str)
+    return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+
+def observation_text(obs: dict, r: int, categories: tuple[str, ...], names: tuple[str, ...]) -> str:
+    """Row ``r`` of the symbolic observation as text (the ``text``
+    observation of MLLM agents): per view, the free distance ahead and the
+    objects in sight with their perceived attributes."""
+    lines = []
+    fs = obs["free_space"][r]
+    handles, cats, views, ranges, attrs = (obs[k][r] for k in ("visible_handle", "visible_category", "visible_view",
+                                                                "visible_range", "visible_attrs"))
+    for k in range(fs.shape[0]):
+        seen = []
+        for j in np.flatnonzero((handles >= 0) & (views == k)):
+            words = [vocab.attribute_word(a, int(attrs[j, a])) for a in range(4) if attrs[j, a] >= 0]
+            words = [w for w in words if w]
+            cat = vocab.category_display(categories[int(cats[j])]) if 0 <= cats[j] < len(categories) else "object"
+            seen.append(f"{' '.join(words + [cat])} (object {int(handles[j])}, about {float(ranges[j]):.1f} m)")
+        name = names[k] if k < len(names) else f"view {k}"
+        lines.append(f"- {name}: open floor for about {float(fs[k].min()):.1f} m; "
+                     + (f"you see {', '.join(seen)}" if seen else "nothing of note"))
+    room = int(obs["room_label"][r])
+    if 0 <= room < len(vocab.ALL_ROOM_LABELS):
+        lines.insert(0, f"You seem to be in a {vocab.ROOM_DISPLAY[vocab.ALL_ROOM_LABELS[room]]}.")
+    return "\n".join(lines)
+
+
+def _last_move_text(obs: dict, r: int, kind: int) -> str:
+    if kind != MOVE:
+        return ""
+    moved = float(obs["last_move"][r])
+    if moved < 0.05:
+        return "the way was blocked; you did not move."
+    return f"you moved {moved:.1f} m" + ("; part of the way was blocked." if obs["blocked"][r].any() else ".")
+
+
+# The loop's jitted pieces take the world as an argument (its configuration is
+# static), so every loop over the same world shapes reuses one compilation.
+@jax.jit
+def _reset_rows(world, specs, keys, mask, states):
+    new = jax.vmap(lambda s, k: E.reset(world, s, k))(specs, keys)
+    return T.tree_select(mask, new, states)
+
+
+@jax.jit
+def _reset_all(world, specs, keys):
+    return jax.vmap(lambda s, k: E.reset(world, s, k))(specs, keys)
+
+
+@jax.jit
+def _step_rows(world, states, actions, mask):
+    """Step the rows in ``mask`` (the others stay as they are) and their trajectory records."""
+    obs = jax.vmap(lambda s: E.observe(world, s))(states)
+    after = T.tree_select(mask, E.step_batch(world, states, actions), states)
+    kind = jnp.where(states.done | ~mask, -1, jnp.clip(actions.kind, 0, 2))
+    return after, step_record(obs, actions, kind, states, after, world.config.n_views)
+
+
+@jax.jit
+def _abort_rows(states, mask):
+    return dataclasses.replace(states, done=states.done | mask,
+                               stop_reason=jnp.where(mask & ~states.done, T.ABORTED, states.stop_reason))
+
+
+@jax.jit
+def _observe_rows(world, states):
+    return jax.vmap(lambda s: E.observe(world, s))(states)
+
+
+@jax.jit
+def _outcome_rows(world, states):
+    return jax.vmap(lambda s: E.outcome(world, s))(states)
+
+
+class HostLoop:
+    """One agent over an episode set (:func:`run_llm_agent` builds and runs it)."""
+
+    def __init__(self, es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, *, sim: T.SimConfig, views: ViewConfig,
+                 batch: int, seed: int, costs, out: Path | None, save_images: int, progress: bool):
+        from ignjax.evaluate.runner import make_world
+
+        self.es, self.agent, self.llm, self.sim, self.views = es, agent, llm, sim, views
+        self.seed, self.costs, self.out, self.save_images, self.progress = seed, tuple(costs), out, save_images, progress
+        self.world = make_world(es, sim)
+        E.check_specs(self.world, es.specs)
+        self.n = len(es)
+        self.B = max(1, min(int(batch), self.n))
+        self.keys = episode_keys(seed, np.arange(self.n))
+        self.names = self._view_names()
+        self.categories = es.bank.categories
+        self.renderer = None
+        w = self.world
+        self._reset = lambda *a: _reset_rows(w, *a)
+        self._reset_all = lambda *a: _reset_all(w, *a)
+        self._step = lambda *a: _step_rows(w, *a)
+        self._abort = _abort_rows
+        self._observe = lambda st: _observe_rows(w, st)
+        self._outcome = lambda st: _outcome_rows(w, st)
+
+    def _view_names(self):
+        from ignjax.sim.views.compose import view_names
+
+        return view_names(self.sim.n_views)
+
+    # -- checkpoint -----------------------------------------------------------
+    def _progress_path(self) -> Path | None:
+        return None if self.out is None else self.out / "llm" / f"{self.agent.name}.progress.jsonl"
+
+    def _load_progress(self, key: str) -> dict[int, dict]:
+        path = self._progress_path()
+        if path is None or not path.exists():
+            return {}
+        done = {}
+        with open(path, encoding="utf-8") as fh:
+            lines = fh.read().split("\n")
+        try:
+            head = json.loads(lines[0])
+        except (json.JSONDecodeError, IndexError):
+            raise InputError(path, "line 1", "not a progress header; delete the file to start over") from None
+        if head.get("settings") != key:
+            raise InputError(path, "settings", "the run there was made with other settings (episodes, agent, model, "
+                                               "simulator, views, seed or costs); use another --out or delete it")
+        for line in lines[1:]:
+            try:
+                rec = json.loads(line)
+            except json.JSONDecodeError:
+                continue  # the last line of a killed run may be cut
+            done[int(rec["index"])] = rec
+        return done
+
+    # -- per-row host work ----------------------------------------------------
+    def _decisions(self, rows, slots, states, obs) -> list[Decision]:
+        """Decisions of ``rows`` (render, compose and encode their panels)."""
+        panels = [None] * len(rows)
+        if self.agent.observation == "panel":
+            from ignjax.sim.views.encode import encode_images
+
+            if self.renderer is None:
+                from ignjax.sim.views import ViewRenderer
+
+                self.renderer = ViewRenderer(self.es.bank, self.sim, self.views)
+            scene = np.asarray(states.episode.scene)[rows]
+            pose = np.asarray(states.pose)[rows]
+            v = self.renderer.render(scene, pose)
+            fmt = self.views.image_format
+            data = encode_images(self.renderer.panels(v), fmt, self.views.quality)
+            mime = "image/jpeg" if fmt == "jpeg" else "image/png"
+            panels = [ImagePart(b, mime) for b in data]
+        out = []
+        step = np.asarray(states.step)
+        qleft = np.asarray(obs["questions_left"])
+        for j, r in enumerate(rows):
+            ep = slots[r]
+            rec = self.es.records[ep.index]
+            text = None if self.agent.observation == "panel" else observation_text(obs, r, self.categories, self.names)
+            last_kind = ep.calls[-1]["action"][0] if ep.calls and ep.calls[-1].get("action") else -1
+            d = Decision(episode=rec["episode_id"], step=int(step[r]), max_steps=self.sim.max_steps,
+                         goal=vocab.category_display(rec["target_category"]), questions_left=int(qleft[r]),
+                         costs=self.costs, answers=tuple(ep.answers),
+                         last_move=" ".join(t for t in (_last_move_text(obs, r, last_kind), ep.progress) if t),
+                         n_views=self.sim.n_views, panel=panels[j], observation=text)
+            if panels[j] is not None and ep.index < self.save_images:
+                ep.images.append((int(step[r]), panels[j]))
+            out.append(d)
+        return out
+
+    async def _decide(self, client: ChatClient, ep: _Episode, d: Decision):
+        """One decision: request, parse, re-ask; ``("act", tuple)`` or ``("fail", reason)``."""
+        agent = self.agent
+        req = agent.request(ep.memory, d)
+        earlier = []
+        for attempt in range(agent.reasks + 1):
+            try:
+                res = await client.complete(req)
+            except LLMRequestError as e:
+                ep.calls.append(self._call(d, req, None, None, earlier, str(e)))
+                return "fail", str(e)
+            ep.acc["requests"] += 0 if res.cache_hit else 1
+            ep.acc["cache_hits"] += int(res.cache_hit)
+            ep.acc["prompt_tokens"] += res.prompt_tokens
+            ep.acc["completion_tokens"] += res.completion_tokens
+            ep.acc["retries"] += res.retries
+            ep.acc["model_latency_s"] += 0.0 if res.cache_hit else res.latency_s
+            act, err = agent.action(ep.memory, d, res.parsed, res.parse_error)
+            if act is not None:
+                ep.calls.append(self._call(d, req, res, act, earlier, None))
+                return "act", act
+            ep.acc["invalid_replies"] += 1
+            earlier.append({"reply": res.text, "error": err, "request_hash": res.request_hash})
+            if attempt < agent.reasks:
+                req = agent.correction(ep.memory, d, req, res.text, err)
+        act = agent.default_action(ep.memory, d)
+        ep.calls.append(self._call(d, req, None, act, earlier, "invalid replies: default action taken"))
+        return "act", act
+
+    def _call(self, d: Decision, req, res, act, earlier, error) -> dict:
+        text = "\n\n".join(p if isinstance(p, str) else p.get("text", "") if isinstance(p, dict) else f"[image {p.sha256[:12]}]"
+                           for m in req.messages for p in ([m["content"]] if isinstance(m["content"], str) else m["content"]))
+        images = [p.sha256 for m in req.messages if not isinstance(m["content"], str) for p in m["content"]
+                  if isinstance(p, ImagePart)]
+        return {"agent": self.agent.name, "episode": d.episode, "step": d.step, "role": "planner", "prompt": text,
+                "reply": res.text if res else "", "parsed": res.parsed if res else None, "retries": earlier,
+                "error": error, "action": list(act) if act else None,
+                "request_hash": res.request_hash if res else None, "images": images,
+                "prompt_tokens": res.prompt_tokens if res else 0, "completion_tokens": res.completion_tokens if res else 0,
+                "latency_s": round(res.latency_s, 4) if res else 0.0, "cache_hit": bool(res.cache_hit) if res else False,
+                "http_retries": res.retries if res else 0}
+
+    # -- the loop -------------------------------------------------------------
+    async def run(self) -> LoopResult:
+        key = _settings_hash(self.es, self.agent, self.llm, self.sim, self.views, self.seed, self.costs)
+        finished = self._load_progress(key)
+        path = self._progress_path()
+        log = None
+        if path is not None:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            if not path.exists():
+                atomic_write(path, json.dumps({"settings": key, "agent": self.agent.name, "episodes": self.n}) + "\n")
+            log = open(path, "a", encoding="utf-8")
+        queue = [i for i in range(self.n) if i not in finished]
+        queue.reverse()
+        B, specs_all = self.B, self.es.specs
+        # every slot starts empty: a padding episode (valid False) is done at reset
+        pad = jax.tree.map(lambda a: a[np.zeros(B, np.int64)], specs_all)
+        pad = dataclasses.replace(pad, valid=jnp.zeros(B, bool))
+        states = self._reset_all(pad, self.keys[np.zeros(B, np.int64)])
+        slots: list[_Episode | None] = [None] * B
+        records: dict[int, dict] = {}
+        traj_rows: dict[int, list] = {}
+        t_start = time.perf_counter()
+        decisions = 0
+        bar = None
+        if self.progress:
+            from tqdm.auto import tqdm
+            import sys
+
+            bar = tqdm(total=self.n, initial=len(finished), desc=self.agent.name, unit="ep", file=sys.stderr,
+                       dynamic_ncols=True)
+
+        def fill(states, free_rows):
+            rows, idx = [], []
+            for r in free_rows:
+                if not queue:
+                    break
+                i = queue.pop()
+                slots[r] = _Episode(i, self.agent.start(self.es.records[i]["episode_id"]))
+                traj_rows[i] = []
+                rows.append(r)
+                idx.append(i)
+            if not rows:
+                return states, []
+            take = np.zeros(B, np.int64)
+            take[rows] = idx
+            mask = np.zeros(B, bool)
+            mask[rows] = True
+            specs = jax.tree.map(lambda a: a[take], specs_all)
+            return self._reset(specs, self.keys[take], jnp.asarray(mask), states), rows
+
+        cache = ResponseCache(self.llm.cache_dir) if self.llm.cache_dir else None
+        loop = asyncio.get_running_loop()
+        try:
+            async with ChatClient(self.llm, cache=cache) as client:
+                t_stats0 = client.stats()
+                states, need = fill(states, list(range(B)))
+                tasks: dict = {}
+                while True:
+                    if need:
+                        rows = sorted(need)
+                        obs = await loop.run_in_executor(None, lambda st=states: jax.tree.map(
+                            np.asarray, dataclasses.asdict(self._observe(st))))
+                        ds = await loop.run_in_executor(None, self._decisions, rows, slots, states, obs)
+                        for r, d in zip(rows, ds):
+                            tasks[asyncio.ensure_future(self._decide(client, slots[r], d))] = r
+                        need = []
+                    if not tasks:
+                        break
+                    done, _ = await asyncio.wait(list(tasks), return_when=asyncio.FIRST_COMPLETED)
+                    ready = {tasks.pop(t): t.result() for t in done}
+                    acts = np.zeros((B, 5), np.int32)
+                    acts[:, 3] = 1
+                    acts[:, 4] = 1
+                    step_mask = np.zeros(B, bool)
+                    fail_mask = np.zeros(B, bool)
+                    for r, (what, value) in ready.items():
+                        if what == "act":
+                            acts[r] = value
+                            step_mask[r] = True
+                        else:
+                            fail_mask[r] = True
+                            slots[r].failure = value
+                    decisions += int(step_mask.sum())
+                    before_step = await loop.run_in_executor(None, np.asarray, states.step)
+                    action = T.Action(kind=jnp.asarray(acts[:, 0]), direction=jnp.asarray(acts[:, 1]),
+                                      col=jnp.asarray(acts[:, 2]), row=jnp.asarray(acts[:, 3]),
+                                      question=jnp.asarray(acts[:, 4]), candidate=jnp.full(B, -1, jnp.int32))
+                    states, rec = await loop.run_in_executor(None, self._step, states, action, jnp.asarray(step_mask))
+                    if fail_mask.any():
+                        states = await loop.run_in_executor(None, self._abort, states, jnp.asarray(fail_mask))
+                    rec, pose, done_now, answers = await loop.run_in_executor(None, lambda st=states, rc=rec: (
+                        [np.asarray(x) for x in rc], np.asarray(st.pose), np.asarray(st.done),
+                        jax.tree.map(np.asarray, st.answers)))
+                    for r in np.flatnonzero(step_mask):
+                        ep = slots[r]
+                        traj_rows[ep.index].append((int(before_step[r]), pose[r], [x[r] for x in rec]))
+                        if acts[r, 0] == ASK:
+                            q = int(acts[r, 4])
+                            er = self.es.records[ep.index]
+                            txt = OT.answer_text(
+                                q, bool(answers.refused[r]), appearance=er["oracle"]["appearance"],
+                                region=er["oracle"]["region"], hint_room_label=int(answers.hint_room_label[r]),
+                                hint_sector=int(answers.hint_sector[r]), hint_landmark=int(answers.hint_landmark[r]),
+                                hint_in_room=bool(answers.hint_in_room[r]), confirm=int(answers.confirm[r]),
+                                follow_up=int(answers.follow_up[r]), categories=self.categories,
+                                key=f"{er['episode_id']}:{int(before_step[r])}")
+                            ep.answers.append((q, txt))
+                        elif acts[r, 0] == MOVE:
+                            ep.progress = OT.hint_progress_text(int(answers.hint_progress[r])) \
+                                if answers.hint_active[r] else ""
+                    ended = [r for r in np.flatnonzero((step_mask | fail_mask) & done_now)]
+                    if ended:
+                        outs = await loop.run_in_executor(None, lambda st=states: jax.tree.map(np.asarray, self._outcome(st)))
+                        for r in ended:
+                            ep = slots[r]
+                            entry = self._entry(ep, outs, r, traj_rows.pop(ep.index), pose[r])
+                            records[ep.index] = entry
+                            if log:
+                                log.write(json.dumps(entry) + "\n")
+                                log.flush()
+                                os.fsync(log.fileno())
+                            self._write_images(ep)
+                            slots[r] = None
+                            if bar:
+                                st = client.stats()
+                                bar.set_postfix_str(f"in flight {st.in_flight}, tok {st.prompt_tokens + st.completion_tokens}, "
+                                                    f"retries {st.retries}", refresh=False)
+                                bar.update(1)
+                        states, refilled = await loop.run_in_executor(None, fill, states, ended)
+                    else:
+                        refilled = []
+                    need = sorted(set(r for r in np.flatnonzero(step_mask & ~done_now)) | set(refilled))
+                stats = client.stats()
+                util = client.utilisation(t_stats0)
+        finally:
+            if log:
+                log.close()
+            if bar:
+                bar.close()
+            if cache is not None:
+                cache.close()
+            if self.renderer is not None:
+                self.renderer.close()
+        records.update(finished)
+        return self._result(records, {"wall_s": time.perf_counter() - t_start, "decisions": decisions,
+                                      "utilisation": util, "requests": stats.requests_sent,
+                                      "max_in_flight": stats.max_in_flight, "resumed": len(finished)})
+
+    def _write_images(self, ep: _Episode) -> None:
+        if self.out is None or not ep.images:
+            return
+        eid = self.es.records[ep.index]["episode_id"]
+        folder = self.out / "images" / self.agent.name / eid
+        for step, img in ep.images:
+            ext = "jpg" if img.mime == "image/jpeg" else "png"
+            atomic_write(folder / f"{step:03d}_panel.{ext}", img.data)
+
+    def _entry(self, ep: _Episode, outs: dict, r: int, steps: list, final_pose) -> dict:
+        o = {k: np.asarray(getattr(outs, k))[r].tolist() for k in outs.__dataclass_fields__}
+        S = self.sim.max_steps
+        names = T.Trajectory.STEP_FIELDS
+        start = np.asarray(self.es.specs.start[ep.index], np.float32)
+        pose = np.repeat(np.asarray(final_pose, np.float32)[None], S + 1, 0)
+        pose[0] = start
+        cols = {}
+        steps.sort(key=lambda s: s[0])
+        for t, p, rec in steps:
+            pose[t + 1] = p
+        last = len(steps)
+        if last:
+            pose[1:last + 1] = [p for _, p, _ in steps]
+            pose[last + 1:] = steps[-1][1]
+        for k, name in enumerate(names):
+            if steps:
+                vals = np.stack([rec[k] for _, _, rec in steps])
+                fill = np.repeat(vals[-1:], S - last, 0)
+                if name in ("kind", "direction", "col", "row", "candidate"):
+                    fill[:] = -1
+                elif name == "question":
+                    fill[:] = 0
+                elif name in ("blocked", "refused"):
+                    fill[:] = False
+                cols[name] = np.concatenate([vals, fill]).tolist()
+            else:
+                cols[name] = None
+        return {"index": ep.index, "episode_id": self.es.records[ep.index]["episode_id"], "outcome": o,
+                "trajectory": {"pose": pose.tolist(), **cols}, "accounting": dict(ep.acc), "failure": ep.failure,
+                "calls": ep.calls}
+
+    def _result(self, records: dict[int, dict], stats: dict) -> LoopResult:
+        order = [records[i] for i in range(self.n)]
+        first = next((r for r in order if r["trajectory"]["kind"] is not None), None)
+
+        def traj_field(name):
+            rows = []
+            for r in order:
+                v = r["trajectory"][name]
+                if v is None:  # an episode that never stepped (failed at its first decision)
+                    v = np.zeros_like(np.asarray(first["trajectory"][name])) if first else np.zeros((self.sim.max_steps,))
+                rows.append(np.asarray(v))
+            return np.stack(rows)
+
+        dtypes = {f.name: None for f in dataclasses.fields(T.OutcomeRow)}
+        outcomes = T.OutcomeRow(**{k: np.asarray([r["outcome"][k] for r in order]) for k in dtypes})
+        traj = T.Trajectory(pose=np.stack([np.asarray(r["trajectory"]["pose"], np.float32) for r in order]),
+                            **{k: traj_field(k) for k in T.Trajectory.STEP_FIELDS})
+        acc = {k: np.asarray([r["accounting"][k] for r in order]) for k in ACCOUNTING}
+        acc["failure"] = [r["failure"] for r in order]
+        calls = [c for r in order for c in r["calls"]]
+        return LoopResult(outcomes=outcomes, trajectories=traj, accounting=acc, stats=stats, transcripts=calls)
+
+
+def run_llm_agent(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, *, sim: T.SimConfig = T.SimConfig(),
+                  views: ViewConfig = ViewConfig(size=224), batch: int = 64, seed: int = 0, costs=LOCKED_COSTS,
+                  out: str | os.PathLike | None = None, save_images: int = 0, progress: bool = False) -> LoopResult:
+    """Run an MLLM agent over every episode of ``es`` (module docstring).
+
+    Args:
+        es: the episodes.
+        agent: the MLLM agent (:mod:`ignjax.agents.llm.agent`).
+        llm: endpoints, model and request settings (cache in ``llm.cache_dir``).
+        sim: simulator settings (``n_views`` is the panel's view count).
+        views: image settings (default 224 px views: a 672 px panel).
+        batch: episodes in flight at once (slots).
+        seed: seed of the episodes' keys (as :func:`ignjax.evaluate.runner.run_agent`).
+        costs: the question costs shown to a cost-aware agent.
+        out: run folder for the checkpoint (``llm/<agent>.progress.jsonl``) and
+            images; None: no checkpoint.
+        save_images: write the panels of the first N episodes to
+            ``images/<agent>/<episode id>/<step>_panel.jpg`` (for the viewer).
+        progress: show a progress bar (episodes, ETA, requests in flight,
+            tokens, retries).
+
+    Raises:
+        ReplayMissError: under ``llm.replay``, a request not in the cache.
+        InputError: a checkpoint written with other settings.
+    """
+    if batch < 1:
+        raise ConfigError(None, "batch", f"must be >= 1, got {batch}")
+    loop = HostLoop(es, agent, llm, sim=sim, views=views, batch=batch, seed=seed, costs=costs,
+                    out=Path(out) if out is not None else None, save_images=save_images, progress=progress)
+    return asyncio.run(loop.run())
+
+
+def write_transcripts(folder: str | os.PathLike, agent: str, calls: list) -> Path:
+    """``<folder>/transcripts/<agent>.jsonl``: one record per model call, sorted by
+    episode (file order) and step (:mod:`ignjax.view`'s transcript schema plus
+    request hash, image hashes, tokens, latency, cache hit)."""
+    path = Path(folder) / "transcripts" / f"{agent}.jsonl"
+    atomic_write(path, "".join(json.dumps(c, sort_keys=True) + "\n" for c in calls))
+    return path
+
+
+__all__ = ["ACCOUNTING", "HostLoop", "LoopResult", "observation_text", "run_llm_agent", "write_transcripts"]
