@@ -25,6 +25,7 @@ process, on the same inputs:
   call, compile included, ``in_loop_run_s`` a second, compiled call.
 
 ``--json``: the last line of stdout is one JSON object with every figure.
+``--llm``: only the MLLM host loop's figures (:mod:`ignjax.bench.llm`).
 
 The ray figures are :mod:`ignjax.bench.rays`, the rollout and study figures
 :mod:`ignjax.bench.rollouts`; this module is the command line.
@@ -45,6 +46,9 @@ def main(argv=None) -> int:
     p.add_argument("--quick", action="store_true", help="fewer rays, the EIG and random agents only, K = 16 in the loop")
     p.add_argument("--json", action="store_true", help="end stdout with one JSON line of every figure")
     p.add_argument("--episodes", help="episode file for the rollouts (default: the shipped benchmark)")
+    p.add_argument("--llm", action="store_true",
+                   help="only the MLLM loop's figures (the llm block: batched vs sequential episodes per hour against "
+                        "the local scripted server, utilisation, host ms per decision; ignjax.bench.llm)")
     args = p.parse_args(argv)
     # imported here, not at the top: the figures pull in jax, MuJoCo and the
     # simulator (about 5 s), which ``--help`` should not wait for
@@ -61,6 +65,13 @@ def main(argv=None) -> int:
     device = f"{jax.default_backend()}: {jax.devices()[0].device_kind} x{jax.device_count()}"
     log(f"device {device}")
     res: dict = {"device": device, "quick": args.quick}
+    if args.llm:
+        from ignjax.bench.llm import bench_llm
+
+        log("MLLM host loop against the scripted server ...")
+        res["llm"] = bench_llm(load_benchmark(args.episodes or SHIPPED_BENCHMARK), args.quick)
+        print(json.dumps(res, sort_keys=True) if args.json else json.dumps(res, indent=2, sort_keys=True))
+        return 0
     log("rays ...")
     res.update(bench_rays(args.quick))
     r = res["rays_per_s"]

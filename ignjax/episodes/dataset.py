@@ -143,10 +143,15 @@ def episode_specs(records: list[dict], bank: SceneBank, path: str | os.PathLike 
 
 
 def load_benchmark(path: str | os.PathLike, scenes_root: str | os.PathLike | None = None,
-                   grid: GridConfig = GridConfig(), field_batch: int = 32, progress=None) -> EpisodeSet:
-    """Read, validate and prepare an episode file for simulation (see module doc)."""
+                   grid: GridConfig = GridConfig(), field_batch: int = 32, progress=None,
+                   limit: int | None = None) -> EpisodeSet:
+    """Read, validate and prepare an episode file for simulation (see module
+    doc). ``limit``: only the first N episodes of the file, and only the
+    scenes they use are loaded."""
     p = Path(path)
     records = read_episodes(p)
+    if limit is not None:
+        records = records[:max(0, int(limit))]
     root = Path(scenes_root) if scenes_root else None
     by_file: dict[Path, set[str]] = {}
     first_line: dict[Path, str] = {}

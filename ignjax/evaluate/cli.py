@@ -215,9 +215,7 @@ def run(args) -> int:
     if args.parts < 0:
         raise ConfigError(None, "--parts", f"must be >= 0, got {args.parts}")
     t0 = time.perf_counter()
-    es = load_benchmark(args.episodes, args.scenes_root)
-    if args.limit:
-        es = es.subset(range(min(args.limit, len(es))))
+    es = load_benchmark(args.episodes, args.scenes_root, limit=args.limit or None)
     world = make_world(es, sim)
     print(f"loaded {len(es)} episodes in {len(es.bank.scene_ids)} scenes ({time.perf_counter() - t0:.1f} s)", file=sys.stderr)
     rows = []

@@ -207,6 +207,10 @@ class HostLoop:
         self.names = self._view_names()
         self.categories = es.bank.categories
         self.renderer = None
+        if agent.observation == "panel":  # made before the first request: render workers start here
+            from ignjax.sim.views import ViewRenderer
+
+            self.renderer = ViewRenderer(es.bank, sim, views)
         w = self.world
         self._reset = lambda *a: _reset_rows(w, *a)
         self._reset_all = lambda *a: _reset_all(w, *a)
@@ -253,10 +257,6 @@ class HostLoop:
         if self.agent.observation == "panel":
             from ignjax.sim.views.encode import encode_images
 
-            if self.renderer is None:
-                from ignjax.sim.views import ViewRenderer
-
-                self.renderer = ViewRenderer(self.es.bank, self.sim, self.views)
             scene = np.asarray(states.episode.scene)[rows]
             pose = np.asarray(states.pose)[rows]
             v = self.renderer.render(scene, pose)
@@ -286,7 +286,7 @@ class HostLoop:
         """One decision: request, parse, re-ask; ``("act", tuple)`` or ``("fail", reason)``."""
         agent = self.agent
         req = agent.request(ep.memory, d)
-        earlier = []
+        earlier, res = [], None
         for attempt in range(agent.reasks + 1):
             try:
                 res = await client.complete(req)
@@ -308,7 +308,7 @@ class HostLoop:
             if attempt < agent.reasks:
                 req = agent.correction(ep.memory, d, req, res.text, err)
         act = agent.default_action(ep.memory, d)
-        ep.calls.append(self._call(d, req, None, act, earlier, "invalid replies: default action taken"))
+        ep.calls.append(self._call(d, req, res, act, earlier[:-1], "invalid replies: default action taken"))
         return "act", act
 
     def _call(self, d: Decision, req, res, act, earlier, error) -> dict:
