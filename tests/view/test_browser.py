@@ -195,3 +195,31 @@ def test_images_and_transcripts_are_shown(browser, run_copy, tmp_path, small_ben
     assert browser.execute_script("return arguments[0].textContent", prompt) == "PROMPT TEXT </script>"
     assert "1 retry" in css(browser, ".call", panel)[0].text
     assert console(browser) == []
+
+
+def test_a_vlm_run_from_the_local_model_server(browser, tmp_path):
+    """A run of the ``vlm`` agent through ``python -m ignjax.evaluate`` against
+    the scripted server (transcripts and panels written by the host loop):
+    the page shows each step's panel and the model call of that step."""
+    from ignjax.agents.llm.serve import ScriptedServer
+    from ignjax.evaluate.cli import main as evaluate
+
+    root = Path(__file__).resolve().parents[2]
+    out = tmp_path / "vlm"
+    with ScriptedServer() as srv:
+        assert evaluate(["--episodes", str(root / "scenes" / "benchmark.jsonl.gz"), "--agent", "vlm",
+                         "--llm-endpoint", srv.base_url, "--llm-model", srv.model, "--limit", "2", "--save-images", "1",
+                         "--set", "sim.max_steps=4", "--set", "views.size=64", "--out", str(out), "--quiet"]) == 0
+    calls = [json.loads(line) for line in (out / "transcripts" / "vlm.jsonl").read_text().splitlines()]
+    page = tmp_path / "vlm.html"
+    assert main([str(out), "--out", str(page), "--episodes", "1"]) == 0
+    open_page(browser, page, "#ep=0&a=vlm")
+    (panel,) = css(browser, ".panel")
+    assert panel.get_attribute("data-agent") == "vlm"
+    first = [c for c in calls if c["episode"] == calls[0]["episode"] and c["step"] == 0][0]
+    assert css(browser, ".call pre.reply", panel)[0].text == first["reply"]
+    prompt = browser.execute_script("return arguments[0].textContent", css(browser, ".call pre.prompt", panel)[0])
+    assert prompt == first["prompt"] and "Find the" in prompt
+    imgs = css(browser, ".images img", panel)
+    assert imgs and browser.execute_script("return arguments[0].naturalWidth", imgs[0]) == 3 * 64
+    assert console(browser) == []
