@@ -22,7 +22,8 @@ concurrency, over the whole run (compilation of the simulator's jitted
 pieces happens before the first request and is not counted in it, but is in
 the wall times). ``host_ms_per_decision``: the batched loop against a
 zero-latency server (observation, rendering, composition, encoding,
-request, parse, step), wall time per decision after a warm-up run.
+request, parse, step), wall time per decision after a warm-up run. Both
+loops' programs are compiled before anything is timed.
 ``limited_by`` names what bounds the batched figure: the server's
 concurrency x latency, or the host (rendering and stepping) when its
 decisions per second stay below what the server could answer.
@@ -85,6 +86,7 @@ def bench_llm(es, quick: bool, latency: float = 4.0, concurrency: int = 64) -> d
         with ScriptedServer(latency=0.0, concurrency=concurrency, policy=_policy) as srv:
             warm = es.subset(range(min(concurrency, len(es))))
             _run(warm, srv, concurrency, concurrency, views, sim, None)
+            _run(es.subset(range(1)), srv, 1, 1, views, sim, None)  # the sequential loop's programs, compiled too
             res, wall = _run(warm, srv, concurrency, concurrency, views, sim, None)
         out["host_ms_per_decision"] = 1000.0 * wall / max(1, res.stats["decisions"])
         log(f"  host {out['host_ms_per_decision']:.1f} ms a decision ({res.stats['decisions']} decisions, zero latency)")
