@@ -39,7 +39,8 @@ def jax_cache(tmp_path_factory):
     return tmp_path_factory.mktemp("jax_cache")
 
 
-@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.slow) if n == "difficulty_ablation.ipynb" else n
+                                  for n in NAMES])  # the difficulty notebook takes 80 s: run with -m slow
 def test_notebook_runs_and_shows_figures(name, tmp_path, monkeypatch, jax_cache):
     monkeypatch.setenv("IGNJAX_NOTEBOOK_SMALL", "1")  # the kernel inherits the environment
     monkeypatch.setenv("JAX_COMPILATION_CACHE_DIR", str(jax_cache))

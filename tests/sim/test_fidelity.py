@@ -101,6 +101,7 @@ def test_upfront_description_is_given_and_charged_as_type1_plus_type2(small_benc
     assert disc == pytest.approx(0.709, abs=1e-3)
 
 
+@pytest.mark.slow  # about 2 minutes on a 2-core CPU (a rollout compiled for the unbudgeted protocol)
 def test_unbudgeted_questions_are_never_refused(small_benchmark, small_world):
     es = small_benchmark["set"]
     spec = _spec(es, 1)
@@ -199,6 +200,7 @@ def test_misses_grow_with_distance_and_shrink_with_size(small_world):
     assert near[1] < far[1] and big[1] < far[1]
 
 
+@pytest.mark.slow  # about a minute on a 2-core CPU
 def test_noisy_batch_observation_equals_observing_again(small_benchmark, small_world):
     """The batch step keeps a row's perception when it did not move: with the
     noise keyed on the (rounded) pose, that equals observing it again."""
