@@ -32,7 +32,6 @@ decisions per second stay below what the server could answer.
 from __future__ import annotations
 
 import re
-import tempfile
 import time
 
 from ignjax.bench.timing import log
@@ -81,18 +80,17 @@ def bench_llm(es, quick: bool, latency: float = 4.0, concurrency: int = 64) -> d
     batched_es = es.subset(range(min(n_batched, len(es))))
     out = {"concurrency": concurrency, "latency_s": latency, "views": sim.n_views, "size": views.size,
            "decisions_per_episode": DECISIONS, "episodes": {"batched": len(batched_es), "sequential": n_seq}}
-    with tempfile.TemporaryDirectory() as tmp:
-        # host cost per decision: zero-latency server, after a warm-up (compilation, render workers)
-        with ScriptedServer(latency=0.0, concurrency=concurrency, policy=_policy) as srv:
-            warm = es.subset(range(min(concurrency, len(es))))
-            _run(warm, srv, concurrency, concurrency, views, sim, None)
-            _run(es.subset(range(1)), srv, 1, 1, views, sim, None)  # the sequential loop's programs, compiled too
-            res, wall = _run(warm, srv, concurrency, concurrency, views, sim, None)
-        out["host_ms_per_decision"] = 1000.0 * wall / max(1, res.stats["decisions"])
-        log(f"  host {out['host_ms_per_decision']:.1f} ms a decision ({res.stats['decisions']} decisions, zero latency)")
-        with ScriptedServer(latency=latency, jitter=0.25, concurrency=concurrency, policy=_policy) as srv:
-            res_b, wall_b = _run(batched_es, srv, concurrency, concurrency, views, sim, None)
-            res_s, wall_s = _run(es.subset(range(n_seq)), srv, 1, 1, views, sim, None)
+    # host cost per decision: zero-latency server, after a warm-up (compilation, render workers)
+    with ScriptedServer(latency=0.0, concurrency=concurrency, policy=_policy) as srv:
+        warm = es.subset(range(min(concurrency, len(es))))
+        _run(warm, srv, concurrency, concurrency, views, sim, None)
+        _run(es.subset(range(1)), srv, 1, 1, views, sim, None)  # the sequential loop's programs, compiled too
+        res, wall = _run(warm, srv, concurrency, concurrency, views, sim, None)
+    out["host_ms_per_decision"] = 1000.0 * wall / max(1, res.stats["decisions"])
+    log(f"  host {out['host_ms_per_decision']:.1f} ms a decision ({res.stats['decisions']} decisions, zero latency)")
+    with ScriptedServer(latency=latency, jitter=0.25, concurrency=concurrency, policy=_policy) as srv:
+        res_b, wall_b = _run(batched_es, srv, concurrency, concurrency, views, sim, None)
+        res_s, wall_s = _run(es.subset(range(n_seq)), srv, 1, 1, views, sim, None)
     eph_b = 3600.0 * len(batched_es) / wall_b
     eph_s = 3600.0 * n_seq / wall_s
     out["episodes_per_hour"] = {"batched": eph_b, "sequential": eph_s}

@@ -56,7 +56,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ignjax.agents.llm.agent import ASK, MOVE, Decision, LLMAgent, QUESTION_NAMES
+from ignjax.agents.llm.agent import ASK, MOVE, Decision, LLMAgent
 from ignjax.agents.llm.cache import ResponseCache
 from ignjax.agents.llm.client import ChatClient, ImagePart, LLMRequestError
 from ignjax.agents.llm.config import LLMConfig
@@ -490,8 +490,6 @@ class HostLoop:
         pose[0] = start
         cols = {}
         steps.sort(key=lambda s: s[0])
-        for t, p, rec in steps:
-            pose[t + 1] = p
         last = len(steps)
         if last:
             pose[1:last + 1] = [p for _, p, _ in steps]

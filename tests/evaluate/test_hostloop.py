@@ -8,7 +8,6 @@ killed with SIGKILL that resumes to the same outcomes."""
 from __future__ import annotations
 
 import json
-import os
 import signal
 import subprocess
 import sys
