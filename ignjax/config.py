@@ -2,8 +2,10 @@
 
 :class:`SweepConfig` has one section per TOML table: ``run``, ``benchmark``,
 ``eval``, ``costs``, ``difficulty``, ``derive-costs`` (attribute
-``derive_costs``), ``analysis`` and ``sim`` (the simulator's own
-:class:`ignjax.sim.types.SimConfig`). Each section checks its values in
+``derive_costs``), ``analysis``, ``sim`` (the simulator's own
+:class:`ignjax.sim.types.SimConfig`), ``llm`` (the model server of the MLLM
+agents, :class:`ignjax.agents.llm.config.LLMConfig`) and ``views`` (their
+rendered observations, :class:`ignjax.sim.views.ViewConfig`). Each section checks its values in
 ``__post_init__`` and raises :class:`ConfigError` naming the key, so a
 configuration built from Python is checked like one read from a file.
 
@@ -31,12 +33,15 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from ignjax.agents import registry
+from ignjax.agents.llm.agent import LLM_AGENTS, get_llm_agent
+from ignjax.agents.llm.config import LLMConfig
 from ignjax.agents.params import check_param_value, make_params, param_docs, param_values
 from ignjax.arrays import field_docs, parse_assignment
 from ignjax.episodes.difficulty import validate_alpha, validate_thresholds
 from ignjax.errors import ConfigError
 from ignjax.protocol import DIFFICULTY_ALPHA, DIFFICULTY_THRESHOLDS, LOCKED_COSTS, SUCCESS_REQUIRES_STOP, SUCCESS_THRESHOLDS
 from ignjax.sim.types import SimConfig
+from ignjax.sim.views.config import ViewConfig
 from ignjax.studies.cost_sensitivity import validate_costs
 
 # ---------------------------------------------------------------------------
@@ -89,7 +94,7 @@ def _check_fields(obj, section: str) -> None:
 
 
 def _check_agent(name: str, key: str) -> None:
-    known = registry()
+    known = list(registry()) + list(LLM_AGENTS)
     if name not in known:
         raise ConfigError(None, key, f"unknown agent {name!r}; known: {', '.join(known)}")
 
@@ -148,7 +153,8 @@ class EvalConfig:
     """The evaluation: agents x episodes, and the metrics' settings.
 
     Attributes:
-        agents: the agents evaluated (names of ``ignjax.agents.registry()``).
+        agents: the agents evaluated: JAX-native agents (``ignjax.agents.registry()``) and MLLM agents
+            (``ignjax.agents.llm.agent.LLM_AGENTS``, e.g. ``vlm``; they need the ``[llm]`` table's server).
         batch: episodes per compiled rollout.
         parts: concurrent pieces of each batch; 0: the default split (``ignjax.sim.rollout.batch_parts``, 2 on CPU).
         thresholds: success distances tau of the SR / OSR / WSR columns, m; positive and increasing.
@@ -340,8 +346,10 @@ class AgentsConfig:
         return make_params(registry()[name], self.params[name], costs)
 
     def used(self, names) -> dict[str, dict[str, Any]]:
-        """``name -> parameters`` of the agents ``names`` (for run.json and report headers)."""
-        return {n: dict(self.params[n]) for n in dict.fromkeys(names)}
+        """``name -> parameters`` of the agents ``names`` (for run.json and report headers); an MLLM agent's
+        options."""
+        return {n: dict(self.params[n]) if n in self.params else dict(vars(get_llm_agent(n)))
+                for n in dict.fromkeys(names)}
 
 
 @dataclass(frozen=True)
@@ -357,6 +365,9 @@ class SweepConfig:
         derive_costs: :class:`DeriveCostsConfig` (TOML table ``[derive-costs]``).
         analysis: :class:`AnalysisConfig`.
         sim: the simulator's :class:`ignjax.sim.types.SimConfig`.
+        llm: the model server and request settings of the MLLM agents (:class:`ignjax.agents.llm.config.LLMConfig`);
+            needed only when ``eval.agents`` names one.
+        views: their rendered observations (:class:`ignjax.sim.views.ViewConfig`).
         agents: :class:`AgentsConfig` (tables ``[agents.<name>]``).
     """
 
@@ -368,6 +379,8 @@ class SweepConfig:
     derive_costs: DeriveCostsConfig = dataclasses.field(default_factory=DeriveCostsConfig)
     analysis: AnalysisConfig = dataclasses.field(default_factory=AnalysisConfig)
     sim: SimConfig = dataclasses.field(default_factory=SimConfig)
+    llm: LLMConfig = dataclasses.field(default_factory=LLMConfig)
+    views: ViewConfig = dataclasses.field(default_factory=ViewConfig)
     agents: AgentsConfig = dataclasses.field(default_factory=AgentsConfig)
 
     def __post_init__(self):
@@ -375,7 +388,16 @@ class SweepConfig:
             cls = SECTIONS[_TOML_NAME[f.name]]
             if not isinstance(getattr(self, f.name), cls):
                 raise ConfigError(None, _TOML_NAME[f.name], f"must be a {cls.__name__}, got {getattr(self, f.name)!r}")
-
+        mllm = [a for a in self.eval.agents if a in LLM_AGENTS]
+        if mllm:
+            try:
+                self.llm.check_usable()
+            except ConfigError as e:
+                raise ConfigError(None, e.where, f"{e.reason}: eval.agents names the MLLM agent {mllm[0]!r}, which "
+                                                 "needs a model server (llm.endpoints, llm.model)") from None
+        if self.analysis.agent in LLM_AGENTS:
+            raise ConfigError(None, "analysis.agent", f"the interaction analyses run a JAX-native agent; "
+                                                      f"{self.analysis.agent!r} is an MLLM agent")
     def to_dict(self) -> dict[str, dict[str, Any]]:
         """``TOML table -> key -> value`` (lists for tuples): ``run.json``'s ``config``."""
         def plain(items):
@@ -401,7 +423,7 @@ class SweepConfig:
 SECTIONS: dict[str, type] = {
     "run": RunConfig, "benchmark": BenchmarkConfig, "eval": EvalConfig, "costs": CostsConfig,
     "difficulty": DifficultyConfig, "derive-costs": DeriveCostsConfig, "analysis": AnalysisConfig, "sim": SimConfig,
-    "agents": AgentsConfig,
+    "llm": LLMConfig, "views": ViewConfig, "agents": AgentsConfig,
 }
 """TOML table name -> section class, in file order."""
 _ATTR_NAME = {name: name.replace("-", "_") for name in SECTIONS}
@@ -413,6 +435,7 @@ QUICK: dict[str, dict[str, Any]] = {
     "costs": {"samples": 20_000, "scales": [0.25, 1.0, 4.0]},
     "difficulty": {"alpha_step": 0.1, "threshold_step": 0.1},
     "analysis": {"trajectories": 2},
+    "views": {"size": 224},
 }
 """The sizes ``--quick`` replaces (CI and smoke runs)."""
 
@@ -554,9 +577,17 @@ def digest(obj: Any) -> str:
     return hashlib.sha256(json.dumps(obj, sort_keys=True).encode()).hexdigest()[:16]
 
 
+FINGERPRINT_IGNORES = {"llm": ("endpoints", "concurrency", "timeout_s", "cache_dir", "replay"), "views": ("workers",)}
+"""Settings that change how a run is served or computed, not its outputs: a run resumed with another model
+server address, concurrency or render process count is the same run."""
+
+
 def fingerprint(cfg: SweepConfig, studies: list[str]) -> str:
-    """Hash of what determines a run's outputs (configuration + studies)."""
-    return digest({"config": cfg.to_dict(), "studies": list(studies)})
+    """Hash of what determines a run's outputs (configuration + studies; not :data:`FINGERPRINT_IGNORES`)."""
+    d = cfg.to_dict()
+    for section, keys in FINGERPRINT_IGNORES.items():
+        d[section] = {k: v for k, v in d[section].items() if k not in keys}
+    return digest({"config": d, "studies": list(studies)})
 
 
 # ---------------------------------------------------------------------------
@@ -573,6 +604,8 @@ def _toml_value(v: Any) -> str:
         return repr(v)
     if isinstance(v, str):
         return json.dumps(v)
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{json.dumps(k)} = {_toml_value(x)}" for k, x in v.items()) + "}"
     return "[" + ", ".join(_toml_value(x) for x in v) + "]"
 
 
@@ -599,7 +632,9 @@ def to_toml(cfg: SweepConfig, header: str = "") -> str:
         out.append(f"[{name}]")
         for f in dataclasses.fields(section):
             out += textwrap.wrap(docs.get(f.name, "").replace("``", "`"), 110, initial_indent="# ", subsequent_indent="# ")
-            out.append(f"{f.name} = {_toml_value(getattr(section, f.name))}")
+            value = getattr(section, f.name)
+            # TOML has no null: a setting that is unset by default is shown commented out
+            out.append(f"# {f.name} = (unset)" if value is None else f"{f.name} = {_toml_value(value)}")
     return "\n".join(out) + "\n"
 
 

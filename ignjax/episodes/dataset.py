@@ -144,12 +144,19 @@ def episode_specs(records: list[dict], bank: SceneBank, path: str | os.PathLike 
 
 def load_benchmark(path: str | os.PathLike, scenes_root: str | os.PathLike | None = None,
                    grid: GridConfig = GridConfig(), field_batch: int = 32, progress=None,
-                   limit: int | None = None) -> EpisodeSet:
+                   limit: int | None = None, indices=None) -> EpisodeSet:
     """Read, validate and prepare an episode file for simulation (see module
-    doc). ``limit``: only the first N episodes of the file, and only the
-    scenes they use are loaded."""
+    doc). ``limit``: only the first N episodes of the file; ``indices``: only
+    these episodes (positions in the file, kept in this order); either way
+    only the scenes they use are loaded."""
     p = Path(path)
     records = read_episodes(p)
+    if indices is not None:
+        idx = [int(i) for i in indices]
+        bad = [i for i in idx if not 0 <= i < len(records)]
+        if bad:
+            raise EpisodeError(p, "indices", f"episode index {bad[0]} is outside the file's {len(records)} episodes")
+        records = [records[i] for i in idx]
     if limit is not None:
         records = records[:max(0, int(limit))]
     root = Path(scenes_root) if scenes_root else None

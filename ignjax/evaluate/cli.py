@@ -154,26 +154,6 @@ def llm_settings(args, sections: dict, out_dir: Path):
     return llm, views
 
 
-def model_totals(rows: list[dict], llm) -> dict[str, dict]:
-    """Per MLLM agent: the accounting columns summed over its episodes, the
-    episodes ended by model failure, and a cost estimate from ``llm.prices``
-    (USD per million prompt / completion tokens; None without prices)."""
-    from ignjax.agents.llm.client import price
-
-    out: dict[str, dict] = {}
-    for r in rows:
-        if not (r["requests"] or r["cache_hits"] or r["failure"]):
-            continue
-        t = out.setdefault(r["agent"], {"requests": 0, "cache_hits": 0, "prompt_tokens": 0, "completion_tokens": 0,
-                                        "retries": 0, "invalid_replies": 0, "failures": 0})
-        for k in ("requests", "cache_hits", "prompt_tokens", "completion_tokens", "retries", "invalid_replies"):
-            t[k] += int(r[k])
-        t["failures"] += int(bool(r["failure"]))
-    for t in out.values():
-        t["cost_usd"] = price(t["prompt_tokens"], t["completion_tokens"], llm.prices if llm else None)
-    return out
-
-
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     try:
@@ -193,8 +173,8 @@ def run(args) -> int:
     from ignjax.agents.params import make_params, param_values_of
     from ignjax.episodes.dataset import load_benchmark
     from ignjax.evaluate.runner import make_world, run_agent
-    from ignjax.evaluate.outcomes import (TRAJECTORY_FILE, metric_rows, outcome_rows, write_metric_table,
-                                          write_outcomes, write_trajectories)
+    from ignjax.evaluate.outcomes import (TRAJECTORY_FILE, metric_rows, model_totals, outcome_rows,
+                                          write_metric_table, write_outcomes, write_trajectories)
 
     from ignjax.agents.llm.agent import LLM_AGENTS, get_llm_agent
     from ignjax.evaluate.hostloop import run_llm_agent, write_transcripts
@@ -255,12 +235,12 @@ def run(args) -> int:
     run_record = {"episodes": str(args.episodes), "seed": args.seed, "batch": args.batch, "thresholds": list(thresholds),
                   "costs": list(costs), "require_stop": args.require_stop,
                   "success_rule": M.success_rule(args.require_stop), "sim": sim.to_dict(), "agents": used,
-                  "limit": args.limit, "model_totals": model_totals(rows, llm)}
+                  "limit": args.limit, "model_totals": model_totals(rows, llm.prices if llm else None)}
     atomic_write(out_dir / "run.json", json.dumps(run_record, indent=2) + "\n")
     print(M.success_rule(args.require_stop))
     if all(t in thresholds for t in SUCCESS_THRESHOLDS):
         print(M.table1(metrics, "text"))
-    for name, totals in model_totals(rows, llm).items():
+    for name, totals in model_totals(rows, llm.prices if llm else None).items():
         cost = f", estimated cost {totals['cost_usd']:.4f} USD" if totals["cost_usd"] is not None else ""
         print(f"{name}: {totals['requests']} requests, {totals['cache_hits']} cache hits, "
               f"{totals['prompt_tokens']} + {totals['completion_tokens']} tokens, {totals['retries']} retries, "

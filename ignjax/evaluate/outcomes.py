@@ -109,6 +109,27 @@ def outcome_rows(agent: str, records: list[dict], out, accounting: dict | None =
     return rows
 
 
+def model_totals(rows: list[dict], prices: dict | None = None) -> dict[str, dict]:
+    """Per MLLM agent: the accounting columns of outcome ``rows`` summed over
+    its episodes, the episodes ended by model failure, and a cost estimate
+    from ``prices`` (``{"prompt": x, "completion": y}`` USD per million
+    tokens, as ``[llm].prices``; ``cost_usd`` None without prices)."""
+    from ignjax.agents.llm.client import price  # aiohttp only when asked
+
+    out: dict[str, dict] = {}
+    for r in rows:
+        if not (r["requests"] or r["cache_hits"] or r["failure"]):
+            continue
+        t = out.setdefault(r["agent"], {"requests": 0, "cache_hits": 0, "prompt_tokens": 0, "completion_tokens": 0,
+                                        "retries": 0, "invalid_replies": 0, "failures": 0})
+        for k in ("requests", "cache_hits", "prompt_tokens", "completion_tokens", "retries", "invalid_replies"):
+            t[k] += int(r[k])
+        t["failures"] += int(bool(r["failure"]))
+    for t in out.values():
+        t["cost_usd"] = price(t["prompt_tokens"], t["completion_tokens"], prices)
+    return out
+
+
 def _arrow_table(rows: list[dict]):
     schema = pa.schema([("agent", pa.string()), ("episode_id", pa.string()), ("scene_id", pa.string()),
                         ("difficulty", pa.string()), ("final_distance", pa.float64()), ("final_euclidean", pa.float64()),
@@ -339,5 +360,5 @@ def read_trajectories(path: str | os.PathLike) -> tuple[dict, dict[str, dict[str
     return meta, out
 
 
-__all__ = ["COLUMNS", "BIN_NAMES", "outcome_rows", "write_outcomes", "read_outcomes", "to_metric_outcomes", "metric_rows",
+__all__ = ["COLUMNS", "BIN_NAMES", "outcome_rows", "model_totals", "write_outcomes", "read_outcomes", "to_metric_outcomes", "metric_rows",
            "write_metric_table", "parse_trace", "TRAJECTORY_FILE", "write_trajectories", "read_trajectories"]

@@ -19,7 +19,8 @@ import numpy as np
 
 from ignjax.config import SweepConfig
 from ignjax.evaluate import metrics as M
-from ignjax.evaluate.outcomes import metric_rows, outcome_rows, write_metric_table, write_outcomes, write_trajectories
+from ignjax.evaluate.outcomes import (metric_rows, model_totals, outcome_rows, write_metric_table, write_outcomes,
+                                      write_trajectories)
 from ignjax.fileio import atomic_write
 from ignjax.protocol import BIN_INDEX, BIN_NAMES, FACTOR_NAMES, SUCCESS_THRESHOLDS
 from ignjax.scenes.viz.mapplot import plot_scene_map, save_figure
@@ -88,7 +89,7 @@ def study_eval(es, rollouts: dict, cfg: SweepConfig, out: Path) -> dict:
     for name, tree in rollouts.items():
         if name not in cfg.eval.agents:
             continue
-        rows += outcome_rows(name, es.records, SimpleNamespace(**tree["out"]))
+        rows += outcome_rows(name, es.records, SimpleNamespace(**tree["out"]), tree.get("accounting"))
         trajectories[name] = tree["traj"]
     write_outcomes(rows, out)
     metrics = metric_rows(rows, tuple(cfg.eval.thresholds), tuple(cfg.eval.costs), cfg.eval.require_stop)
@@ -98,7 +99,7 @@ def study_eval(es, rollouts: dict, cfg: SweepConfig, out: Path) -> dict:
                        sim=cfg.to_dict()["sim"])
     scenes = {sid: es.bank.scene(i) for i, sid in enumerate(es.bank.scene_ids)}
     viewer = write_page(read_run(out, scenes=scenes, title=cfg.run.name), out / VIEWER_FILE)
-    return {"rows": rows, "metrics": metrics, "viewer": viewer}
+    return {"rows": rows, "metrics": metrics, "viewer": viewer, "model_totals": model_totals(rows, cfg.llm.prices)}
 
 
 def in_loop_costs(cfg: SweepConfig) -> tuple[np.ndarray, list[str]]:
@@ -334,6 +335,16 @@ def _section_eval(results: dict, es, rollouts: dict, cfg, out: Path) -> list[str
               "agent, sortable and filterable, replayed step by step on the map with the oracle's answers; "
               "`python -m ignjax.view RUN_DIR` (this folder) rebuilds it, `--gif EPISODE_ID --agent NAME` exports "
               "one episode as an animation).", ""]
+    if ev["model_totals"]:
+        parts += ["MLLM agents' model calls (requests sent to the server, cache hits excluded; tokens as the server "
+                  "counted them; cost from `llm.prices`); per-decision transcripts in `transcripts/<agent>.jsonl`:",
+                  "", "| agent | requests | cache hits | prompt tokens | completion tokens | retries | invalid replies "
+                  "| ended by model failure | cost (USD) |", "|---|---|---|---|---|---|---|---|---|"]
+        for name, t in ev["model_totals"].items():
+            cost = "" if t["cost_usd"] is None else f"{t['cost_usd']:.4f}"
+            parts.append(f"| {name} | {t['requests']} | {t['cache_hits']} | {t['prompt_tokens']} | "
+                         f"{t['completion_tokens']} | {t['retries']} | {t['invalid_replies']} | {t['failures']} | {cost} |")
+        parts.append("")
     return parts
 
 

@@ -1,7 +1,16 @@
 """The sweep's work: the benchmark it runs on, the rollout stages
 (evaluation per agent, the cost-aware agent in the loop), each checkpointed
 as it finishes, and :func:`run_sweep`, which runs them and then writes the
-report (:mod:`ignjax.sweep.report`)."""
+report (:mod:`ignjax.sweep.report`).
+
+An MLLM agent in ``eval.agents`` (``vlm``, ...) runs through the host loop
+(:func:`ignjax.evaluate.hostloop.run_llm_agent`) against the ``[llm]``
+server, with the ``[views]`` observations, ``eval.batch`` episodes in
+flight, the charged ``eval.costs`` shown to it and ``run.seed``. Its
+checkpoint is the host loop's own (``<run>/llm/<agent>.progress.jsonl``,
+one line per finished episode), so ``--resume`` after a kill continues
+episode by episode; replies are cached in ``llm.cache_dir`` (default
+``<run>/llm_cache``), and transcripts go to ``<run>/transcripts/<agent>.jsonl``."""
 
 from __future__ import annotations
 
@@ -16,11 +25,12 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from ignjax.agents import get_agent
+from ignjax.agents.llm.agent import LLM_AGENTS, get_llm_agent
 from ignjax.agents.params import plans_with_costs
 from ignjax.config import SweepConfig, digest
 from ignjax.episodes.construct import BuildConfig, build_benchmark
 from ignjax.episodes.dataset import load_benchmark
-from ignjax.episodes.schema import construction_path, write_records
+from ignjax.episodes.schema import construction_path, read_episodes, write_records
 from ignjax.errors import ConfigError, InputError
 from ignjax.evaluate.runner import episode_batches, make_world, run_agent
 from ignjax.scenes.io.sources import scene_sources
@@ -71,13 +81,14 @@ def benchmark_path(cfg: SweepConfig, out_root: Path, progress=None) -> Path:
 
 def load_episodes(cfg: SweepConfig, path: Path):
     """The episode set at ``path``, cut to ``benchmark.limit`` episodes spread evenly over the file."""
-    es = load_benchmark(path)
-    if len(es) == 0:
+    n = len(read_episodes(path))
+    if n == 0:
         raise InputError(str(path), "episodes", "the episode file holds no episodes")
     limit = cfg.benchmark.limit
-    if 0 < limit < len(es):
-        es = es.subset(np.unique(np.linspace(0, len(es) - 1, limit).round().astype(np.int64)))
-    return es
+    if 0 < limit < n:
+        # only the scenes the chosen episodes use are loaded
+        return load_benchmark(path, indices=np.unique(np.linspace(0, n - 1, limit).round().astype(np.int64)))
+    return load_benchmark(path)
 
 
 # ---------------------------------------------------------------------------
@@ -106,6 +117,23 @@ def run_eval_stage(es, world, agent_name: str, cfg: SweepConfig, ckpt: Checkpoin
     tree = {"out": _to_tree(out), "traj": _to_tree(traj)}
     ckpt.save(name, tree)
     return tree
+
+
+def run_llm_stage(es, agent_name: str, cfg: SweepConfig, out: Path, bar=None, quiet: bool = False) -> dict:
+    """Outcomes, trajectories and model-call accounting of one MLLM agent (module docstring)."""
+    from ignjax.evaluate.hostloop import run_llm_agent, write_transcripts  # aiohttp, renderers: only when asked
+
+    llm = cfg.llm
+    if llm.cache_dir is None:
+        llm = dataclasses.replace(llm, cache_dir=str(out / "llm_cache"))
+    res = run_llm_agent(es, get_llm_agent(agent_name), llm, sim=cfg.sim, views=cfg.views, batch=cfg.eval.batch,
+                        seed=cfg.run.seed, costs=cfg.eval.costs, out=out, progress=not quiet)
+    write_transcripts(out, agent_name, res.transcripts)
+    if bar is not None:
+        bar.update(len(es))
+    acc = {k: np.asarray(v) for k, v in res.accounting.items() if k != "failure"}
+    return {"out": _to_tree(res.outcomes), "traj": _to_tree(res.trajectories),
+            "accounting": {**acc, "failure": list(res.accounting["failure"])}, "stats": res.stats}
 
 
 def run_costs_stage(es, world, cfg: SweepConfig, ckpt: Checkpoints, bar=None) -> dict:
@@ -167,7 +195,8 @@ def run_sweep(cfg: SweepConfig, studies: list[str], out: Path, *, resume: bool =
             rollouts = {}
             for a in agents:
                 bar.set_postfix_str(a)
-                rollouts[a] = run_eval_stage(es, world, a, cfg, ckpt, bar)
+                rollouts[a] = (run_llm_stage(es, a, cfg, out, bar, quiet) if a in LLM_AGENTS
+                               else run_eval_stage(es, world, a, cfg, ckpt, bar))
             if "costs" in studies:
                 bar.set_postfix_str(f"{cfg.costs.agent} x {k_costs} cost vectors")
                 results["in_loop"] = run_costs_stage(es, world, cfg, ckpt, bar)
@@ -179,4 +208,4 @@ def run_sweep(cfg: SweepConfig, studies: list[str], out: Path, *, resume: bool =
 
 
 __all__ = ["REPO_SCENES", "SHIPPED_BENCHMARK", "benchmark_path", "load_episodes", "run_costs_stage",
-           "run_eval_stage", "run_sweep"]
+           "run_eval_stage", "run_llm_stage", "run_sweep"]

@@ -143,9 +143,13 @@ def test_every_sim_field_and_agent_parameter_is_a_config_key():
     toml = tomllib.loads(default_toml())
     assert set(toml["sim"]) == set(changed)
     assert {n: set(v) for n, v in toml["agents"].items()} == {n: set(param_values(a)) for n, a in registry().items()}
+    text = default_toml()
     for section, obj in SweepConfig().sections().items():
         if section != "agents":
-            assert set(toml[section]) == {f.name for f in dataclasses.fields(obj)}, section
+            # a setting unset by default (TOML has no null) is listed commented out
+            unset = {f.name for f in dataclasses.fields(obj) if getattr(obj, f.name) is None}
+            assert set(toml[section]) == {f.name for f in dataclasses.fields(obj)} - unset, section
+            assert all(f"# {k} = (unset)" in text for k in unset), section
 
 
 def test_offline_study_reference_rows(sweep_run):

@@ -384,11 +384,12 @@ class ChatClient:
     def __init__(self, config: LLMConfig, cache: ResponseCache | None = None):
         if not isinstance(config, LLMConfig):
             raise TypeError(f"expected an LLMConfig, got {type(config).__name__}")
+        config.check_usable()
         self.config = config
         self._own_cache = cache is None and config.cache_dir is not None  # opened when entered
         self.cache = cache
         if config.replay and cache is None and config.cache_dir is None:
-            raise ConfigError(None, "[llm].replay", "replay needs a response cache: set cache_dir")
+            raise ConfigError(None, "llm.replay", "replay needs a response cache: set cache_dir")
         n = len(config.endpoints)
         self._key = _Secret(None)
         self._session: aiohttp.ClientSession | None = None

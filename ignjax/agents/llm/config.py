@@ -10,9 +10,15 @@ test double) expect.
 Every value is checked when the config is built, directly or through
 :meth:`LLMConfig.from_dict` (the form a TOML table arrives in); a bad value
 raises :class:`~ignjax.errors.ConfigError` naming the field and the reason,
-e.g. ``[llm].timeout_s: must be > 0, got -1``. The value of
+e.g. ``llm.timeout_s: must be > 0, got -1``. The value of
 ``api_key_env`` is never echoed in an error, in case someone pasted the key
 itself there.
+
+The defaults name no server (``endpoints = []``, ``model = ""``), so that the
+sweep's ``[llm]`` table can exist in every configuration; a config is
+*usable* (:meth:`LLMConfig.check_usable`, called by the client and by
+:meth:`LLMConfig.from_dict`) once it names a model and at least one endpoint
+(or replays from a cache).
 """
 
 from __future__ import annotations
@@ -47,7 +53,7 @@ class LLMConfig:
             replay mode.
         model: the model name sent in every request.
         api_key_env: NAME of the environment variable holding the API key
-            (``None``: never send one). Unset variable: no header.
+            (``None`` or ``""``: never send one). Unset variable: no header.
         temperature: sampling temperature, in [0, 2].
         seed: sampling seed sent with each request (``None``: not sent); also
             seeds the retry jitter.
@@ -78,9 +84,9 @@ class LLMConfig:
             max_tokens, response_format, stream).
     """
 
-    SECTION: ClassVar[str] = "[llm]"
-    endpoints: tuple[str, ...]
-    model: str
+    SECTION: ClassVar[str] = "llm"
+    endpoints: tuple[str, ...] = ()
+    model: str = ""
     api_key_env: str | None = "OPENAI_API_KEY"
     temperature: float = 0.0
     seed: int | None = 0
@@ -102,13 +108,13 @@ class LLMConfig:
         _validate(self, self.SECTION, None)
 
     @classmethod
-    def from_dict(cls, d: Any, where: str = "[llm]", path: str | None = None) -> "LLMConfig":
-        """Build from a plain mapping (a TOML table, JSON object).
+    def from_dict(cls, d: Any, where: str = "llm", path: str | None = None) -> "LLMConfig":
+        """Build a usable config from a plain mapping (a TOML table, JSON object).
 
         Args:
-            d: the mapping; unknown keys are errors, ``endpoints`` and
-                ``model`` are required.
-            where: how the table is named in messages (``[llm]``).
+            d: the mapping; unknown keys are errors, ``endpoints`` (unless
+                ``replay``) and ``model`` are required.
+            where: how the table is named in messages (``llm``).
             path: the file it came from, if any (first part of messages).
         """
         if not isinstance(d, dict):
@@ -118,7 +124,7 @@ class LLMConfig:
         if unknown:
             raise ConfigError(path, f"{where}.{unknown[0]}", f"unknown setting; known: {', '.join(names)}")
         for req in ("endpoints", "model"):
-            if req not in d:
+            if req not in d and not (req == "endpoints" and d.get("replay") is True):
                 raise ConfigError(path, f"{where}.{req}", "required setting is missing")
         values = dict(d)
         if isinstance(values["endpoints"], list):
@@ -128,7 +134,17 @@ class LLMConfig:
             default = next(f.default for f in dataclasses.fields(cls) if f.name == name)
             object.__setattr__(obj, name, values.get(name, default))
         _validate(obj, where, path)
+        obj.check_usable(where, path)
         return obj
+
+    def check_usable(self, where: str = "llm", path: str | None = None) -> None:
+        """Raise :class:`ConfigError` unless the config names a model and at
+        least one endpoint (none needed under ``replay``)."""
+        if not self.endpoints and not self.replay:
+            _fail(path, where, "endpoints", "needs at least one URL such as http://127.0.0.1:8000/v1 "
+                                            "(empty is allowed only with replay = true)")
+        if not self.model.strip():
+            _fail(path, where, "model", "needs the served model's name")
 
     def public_dict(self) -> dict:
         """Plain JSON-ready values, safe for ``run.json``: the config holds no
@@ -195,13 +211,14 @@ def _validate(obj: LLMConfig, where: str, path: str | None) -> None:
         _fail(path, where, "endpoints", "lists the same URL twice")
     if not isinstance(obj.replay, bool):
         _fail(path, where, "replay", f"expected true or false, got {obj.replay!r}")
-    if not eps and not obj.replay:
-        _fail(path, where, "endpoints", "needs at least one URL (empty is allowed only with replay = true)")
     object.__setattr__(obj, "endpoints", eps)
 
-    if not isinstance(obj.model, str) or not obj.model.strip():
-        _fail(path, where, "model", f"expected a non-empty model name, got {obj.model!r}")
+    if not isinstance(obj.model, str):
+        _fail(path, where, "model", f"expected a model name, got {obj.model!r}")
     ak = obj.api_key_env
+    if ak == "":
+        ak = None
+        object.__setattr__(obj, "api_key_env", None)
     if ak is not None and (not isinstance(ak, str) or not _ENV_NAME.match(ak)):
         # never echo the value: it may be the key itself pasted in the wrong place
         _fail(path, where, "api_key_env", "must be the NAME of an environment variable (letters, digits, "

@@ -337,21 +337,21 @@ def test_config_from_dict_and_public_dict_round_trip():
 
 
 @pytest.mark.parametrize("bad, field, words", [
-    ({"temprature": 0.5}, "[llm].temprature", "unknown setting"),
-    ({"timeout_s": -1}, "[llm].timeout_s", "must be > 0"),
-    ({"concurrency": 0}, "[llm].concurrency", "must be >= 1"),
-    ({"concurrency": 2.5}, "[llm].concurrency", "expected an integer"),
-    ({"max_retries": True}, "[llm].max_retries", "expected an integer"),
-    ({"temperature": 3}, "[llm].temperature", "must be <= 2.0"),
-    ({"temperature": "hot"}, "[llm].temperature", "expected a finite number"),
-    ({"structured": "yes"}, "[llm].structured", "must be one of 'auto', 'json_schema', 'none'"),
-    ({"endpoints": ["localhost:8000"]}, "[llm].endpoints[0]", "http:// or https://"),
-    ({"endpoints": []}, "[llm].endpoints", "at least one URL"),
-    ({"backoff_max_s": 0.1}, "[llm].backoff_max_s", "must be >= backoff_base_s"),
-    ({"prices": {"prompt": 1}}, "[llm].prices.completion", "number >= 0"),
-    ({"extra_body": {"model": "x"}}, "[llm].extra_body.model", "set by the client"),
-    ({"image_detail": "ultra"}, "[llm].image_detail", "must be one of"),
-    ({"seed": "zero"}, "[llm].seed", "expected an integer or none"),
+    ({"temprature": 0.5}, "llm.temprature", "unknown setting"),
+    ({"timeout_s": -1}, "llm.timeout_s", "must be > 0"),
+    ({"concurrency": 0}, "llm.concurrency", "must be >= 1"),
+    ({"concurrency": 2.5}, "llm.concurrency", "expected an integer"),
+    ({"max_retries": True}, "llm.max_retries", "expected an integer"),
+    ({"temperature": 3}, "llm.temperature", "must be <= 2.0"),
+    ({"temperature": "hot"}, "llm.temperature", "expected a finite number"),
+    ({"structured": "yes"}, "llm.structured", "must be one of 'auto', 'json_schema', 'none'"),
+    ({"endpoints": ["localhost:8000"]}, "llm.endpoints[0]", "http:// or https://"),
+    ({"endpoints": []}, "llm.endpoints", "at least one URL"),
+    ({"backoff_max_s": 0.1}, "llm.backoff_max_s", "must be >= backoff_base_s"),
+    ({"prices": {"prompt": 1}}, "llm.prices.completion", "number >= 0"),
+    ({"extra_body": {"model": "x"}}, "llm.extra_body.model", "set by the client"),
+    ({"image_detail": "ultra"}, "llm.image_detail", "must be one of"),
+    ({"seed": "zero"}, "llm.seed", "expected an integer or none"),
 ])
 def test_bad_config_values_name_the_field(bad, field, words):
     d = {"endpoints": ["http://127.0.0.1:8000/v1"], "model": "m", **bad}
@@ -361,8 +361,14 @@ def test_bad_config_values_name_the_field(bad, field, words):
 
 
 def test_missing_model_and_key_pasted_into_api_key_env():
-    with pytest.raises(ConfigError, match=r"\[llm\]\.model: required"):
+    with pytest.raises(ConfigError, match=r"llm\.model: required"):
         LLMConfig.from_dict({"endpoints": ["http://h/v1"]})
+    # the defaults (the sweep's [llm] table when no MLLM agent runs) build, but no client starts from them
+    with pytest.raises(ConfigError, match=r"llm\.endpoints: needs at least one URL"):
+        ChatClient(LLMConfig())
+    with pytest.raises(ConfigError, match=r"llm\.model: needs the served model's name"):
+        ChatClient(LLMConfig(endpoints=("http://h/v1",)))
+    assert LLMConfig(endpoints=("http://h/v1",), model="m", api_key_env="").api_key_env is None
     key = "sk-" + secrets.token_hex(12)
     with pytest.raises(ConfigError) as e:
         LLMConfig(endpoints=("http://h/v1",), model="m", api_key_env=key)

@@ -1,0 +1,103 @@
+"""MLLM agents in the main job: ``python -m ignjax.sweep --study eval`` with
+``eval.agents`` naming ``vlm`` beside a JAX-native agent, the model server
+given in the ``[llm]`` table (the scripted server on 127.0.0.1: a test double
+whose replies are computed from the request text) and the observations in
+``[views]``. Checks the outcome tables' accounting columns, the report's
+model-call table, transcripts, a second run answered from the shared cache
+with zero requests and identical outcomes, and the configuration errors."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import pytest
+
+from ignjax.agents.llm.serve import ScriptedServer
+from ignjax.config import fingerprint, resolve
+from ignjax.errors import ConfigError
+from ignjax.sim.views.config import egl_available, warp_available
+from ignjax.sweep.cli import main
+
+ROOT = Path(__file__).resolve().parents[2]
+EPISODES = ROOT / "scenes" / "benchmark.jsonl.gz"
+OUTCOME_FIELDS = ("agent", "episode_id", "final_distance", "steps", "stopped", "stop_reason", "q1", "q2", "q3", "q4",
+                  "trace")
+
+
+def _sets(srv, root: Path, cache: Path) -> list[str]:
+    return [f"benchmark.episodes='{EPISODES}'", "benchmark.limit=3", f"run.out='{root}'",
+            "eval.agents=['random', 'vlm']", "eval.batch=3", "sim.max_steps=6", "views.size=64",
+            f"llm.endpoints=['{srv.base_url}']", f"llm.model='{srv.model}'", "llm.api_key_env=''",
+            f"llm.cache_dir='{cache}'", "llm.timeout_s=10.0", "llm.prices={prompt = 0.5, completion = 2.0}"]
+
+
+def _rows(path: Path) -> list[dict]:
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+@pytest.mark.skipif(warp_available() is not None and egl_available() is not None, reason="no rendering backend")
+def test_sweep_eval_runs_an_mllm_agent_and_reruns_from_the_cache(tmp_path, capsys):
+    with ScriptedServer() as srv:
+        sets = _sets(srv, tmp_path, tmp_path / "cache")
+        argv = ["--study", "eval", "--quiet", "--out", str(tmp_path / "a")] + sum((["--set", s] for s in sets), [])
+        assert main(argv) == 0, capsys.readouterr().err
+        sent = srv.stats()["requests"]
+        assert sent > 0
+        a = _rows(tmp_path / "a" / "outcomes.csv")
+        vlm = [r for r in a if r["agent"] == "vlm"]
+        rnd = [r for r in a if r["agent"] == "random"]
+        assert len(vlm) == len(rnd) == 3
+        # one request per decision (no faults, no bad replies from the scripted policy), none for the JAX agent
+        assert sum(int(r["requests"]) for r in vlm) == sent == sum(int(r["steps"]) for r in vlm)
+        assert all(int(r["prompt_tokens"]) > 0 and r["failure"] == "" for r in vlm)
+        assert all(int(r["requests"]) == 0 and int(r["prompt_tokens"]) == 0 for r in rnd)
+        # transcripts: one record per decision, naming the request's hash
+        lines = (tmp_path / "a" / "transcripts" / "vlm.jsonl").read_text().splitlines()
+        assert len(lines) == sent and all(len(json.loads(x)["request_hash"]) == 64 for x in lines)
+        # the report has the Table-1 rows for both agents and the model-call totals with the cost estimate
+        report = (tmp_path / "a" / "report.md").read_text()
+        assert "| vlm |" in report and "| random |" in report
+        tokens = [sum(int(r[k]) for r in vlm) for k in ("prompt_tokens", "completion_tokens")]
+        cost = (tokens[0] * 0.5 + tokens[1] * 2.0) / 1e6
+        assert f"| vlm | {sent} | 0 | {tokens[0]} | {tokens[1]} | 0 | 0 | 0 | {cost:.4f} |" in report
+        # the agent's options are stated in the report header
+        assert "- Agent `vlm`: observation=panel" in report
+
+        # a second run (another folder, same cache) sends nothing and gives the same outcomes
+        argv_b = ["--study", "eval", "--quiet", "--out", str(tmp_path / "b")] + sum((["--set", s] for s in sets), [])
+        assert main(argv_b) == 0, capsys.readouterr().err
+        assert srv.stats()["requests"] == sent
+        b = _rows(tmp_path / "b" / "outcomes.csv")
+        assert [[r[k] for k in OUTCOME_FIELDS] for r in b] == [[r[k] for k in OUTCOME_FIELDS] for r in a]
+        assert sum(int(r["cache_hits"]) for r in b if r["agent"] == "vlm") == sent
+        assert sum(int(r["requests"]) for r in b) == 0
+
+
+def test_mllm_agent_without_a_server_and_other_llm_config_errors():
+    with pytest.raises(ConfigError) as e:
+        resolve(None, ["eval.agents=['eig', 'vlm']"])
+    assert e.value.where == "llm.endpoints" and "'vlm'" in str(e.value)
+    with pytest.raises(ConfigError) as e:
+        resolve(None, ["eval.agents=['vlm']", "llm.endpoints=['http://127.0.0.1:1/v1']"])
+    assert e.value.where == "llm.model"
+    with pytest.raises(ConfigError) as e:
+        resolve(None, ["llm.timeout_s=-1"])
+    assert e.value.where == "llm.timeout_s" and str(e.value).startswith("--set")
+    with pytest.raises(ConfigError, match="views.size"):
+        resolve(None, ["views.size=20"])
+    with pytest.raises(ConfigError, match="analysis.agent"):
+        resolve(None, ["analysis.agent='vlm'", "llm.endpoints=['http://h/v1']", "llm.model='m'"])
+    with pytest.raises(ConfigError, match="unknown key llm.temprature"):
+        resolve(None, ["llm.temprature=0.5"])
+
+
+def test_where_the_model_is_served_does_not_change_the_run():
+    base = ["eval.agents=['vlm']", "llm.model='m'"]
+    a = resolve(None, base + ["llm.endpoints=['http://10.0.0.1:8000/v1']", "llm.concurrency=4"])
+    b = resolve(None, base + ["llm.endpoints=['http://10.0.0.2:8000/v1', 'http://10.0.0.3:8000/v1']",
+                              "views.workers=2"])
+    c = resolve(None, ["eval.agents=['vlm']", "llm.model='other'", "llm.endpoints=['http://10.0.0.1:8000/v1']"])
+    assert fingerprint(a, ["eval"]) == fingerprint(b, ["eval"]) != fingerprint(c, ["eval"])
