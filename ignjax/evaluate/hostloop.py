@@ -11,14 +11,16 @@ one episode. A round:
    accounting: one checkpoint line each) and refilled from the queue of
    remaining episodes (continuous batching on our side, so the server stays
    busy);
-3. for the rows that need a decision, the jitted observation, then (in a
-   worker thread, while the other rows' requests stay in flight) the views
-   are rendered and the Planner panels composed and encoded
-   (:class:`~ignjax.sim.views.ViewRenderer`), and one request per row is
-   sent; all requests are in flight at once, bounded per endpoint by the
-   client (:class:`~ignjax.agents.llm.client.ChatClient`);
-4. the loop wakes when any reply arrives and takes every reply that has
-   arrived by then.
+3. for the rows that need a decision, the jitted observation; then their
+   views are rendered and the Planner panels composed and encoded
+   (:class:`~ignjax.sim.views.ViewRenderer`) in a worker thread, one render
+   at a time: while it runs, the loop keeps stepping the rows whose replies
+   arrive, and the rows that become ready meanwhile are rendered together
+   in the next call. When a render finishes, one request per row is sent;
+   all requests are in flight at once, bounded per endpoint by the client
+   (:class:`~ignjax.agents.llm.client.ChatClient`);
+4. the loop wakes when any reply or render finishes and takes every reply
+   that has arrived by then.
 
 Bad replies: a reply that does not parse or names an out-of-range value is
 answered with a short correction and asked again (``agent.reasks`` times),
@@ -190,6 +192,52 @@ def _outcome_rows(world, states):
     return jax.vmap(lambda s: E.outcome(world, s))(states)
 
 
+class _Context:
+    """What an agent's :meth:`~ignjax.agents.llm.agent.LLMAgent.decide` may
+    use for one decision: model calls with re-asks (:meth:`query`, counted
+    in the episode's accounting and transcript) and the Grounder image of a
+    view (:meth:`view_image`)."""
+
+    def __init__(self, loop: "HostLoop", client: ChatClient, ep: _Episode, d: Decision):
+        self._loop, self._client, self._ep, self._d = loop, client, ep, d
+        self.defaulted = False
+
+    async def query(self, request, parse, role: str = "planner", reasks: int | None = None):
+        """Send ``request``; ``parse(parsed, parse_error) -> (value, error)``
+        turns a reply into a value or an error, an error is answered with the
+        agent's correction and asked again (``reasks``, default the agent's).
+        Returns the value, or None when every reply was unusable.
+
+        Raises:
+            LLMRequestError: the request kept failing (the episode ends with
+                stop reason ``model_failure``).
+        """
+        n = self._loop.agent.reasks if reasks is None else int(reasks)
+        return await self._loop._query(self._client, self._ep, self._d, request, parse, role, n)
+
+    def view_image(self, k: int) -> ImagePart:
+        """View ``k`` of this decision with the numbered 8x8 grid, encoded (the Grounder's image)."""
+        from ignjax.sim.views.compose import grounder_images
+        from ignjax.sim.views.encode import encode_images
+
+        rgb = self._d.views
+        if rgb is None:
+            raise ValueError("this decision carries no rendered views")
+        if not 0 <= int(k) < rgb.shape[0]:
+            raise ValueError(f"view {k} is outside the {rgb.shape[0]} views")
+        fmt = self._loop.views.image_format
+        data = encode_images(grounder_images(rgb[int(k)][None]), fmt, self._loop.views.quality)[0]
+        img = ImagePart(data, "image/jpeg" if fmt == "jpeg" else "image/png")
+        if self._ep.index < self._loop.save_images:
+            self._ep.images.append((self._d.step, img, f"grounder_{int(k)}"))
+        return img
+
+    def default(self, action):
+        """Mark this decision's action as the default after unusable replies (returns ``action``)."""
+        self.defaulted = True
+        return action
+
+
 class HostLoop:
     """One agent over an episode set (:func:`run_llm_agent` builds and runs it)."""
 
@@ -251,72 +299,109 @@ class HostLoop:
         return done
 
     # -- per-row host work ----------------------------------------------------
-    def _decisions(self, rows, slots, states, obs) -> list[Decision]:
-        """Decisions of ``rows`` (render, compose and encode their panels)."""
-        panels = [None] * len(rows)
-        if self.agent.observation == "panel":
+    def _prepare(self, rows, slots, states, obs) -> list[dict]:
+        """What the decisions of ``rows`` need, taken from this round's state
+        and observation (a row's entries stay as they are until its decision
+        is made, so the panels may be rendered later, while other rows step)."""
+        scene = np.asarray(states.episode.scene)
+        pose = np.asarray(states.pose)
+        step = np.asarray(states.step)
+        qleft = np.asarray(obs["questions_left"])
+        ans = jax.tree.map(np.asarray, states.answers)
+        out = []
+        for r in rows:
+            ep = slots[r]
+            percept = {"open": obs["free_space"][r].min(axis=-1).tolist(), "odometry": obs["odometry"][r][:2].tolist(),
+                       "room": int(obs["room_label"][r]), "known": ans.known[r].tolist(),
+                       "goal_room": int(ans.room_label[r]) if ans.known[r][1] else -1, "confirm": int(ans.confirm[r]),
+                       "follow_up": int(ans.follow_up[r]), "hint_active": bool(ans.hint_active[r]),
+                       "hint_progress": int(ans.hint_progress[r]), "blocked": obs["blocked"][r].tolist()}
+            rec = self.es.records[ep.index]
+            text = None if self.agent.observation == "panel" else observation_text(obs, r, self.categories, self.names)
+            last_kind = ep.calls[-1]["action"][0] if ep.calls and ep.calls[-1].get("action") else -1
+            out.append({"row": r, "scene": int(scene[r]), "pose": pose[r].copy(), "decision": dict(
+                episode=rec["episode_id"], step=int(step[r]), max_steps=self.sim.max_steps,
+                goal=vocab.category_display(rec["target_category"]), questions_left=int(qleft[r]),
+                costs=self.costs, answers=tuple(ep.answers),
+                last_move=" ".join(t for t in (_last_move_text(obs, r, last_kind), ep.progress) if t),
+                n_views=self.sim.n_views, observation=text, percept=percept)})
+        return out
+
+    def _decisions(self, items: list[dict], slots) -> list[tuple[int, Decision]]:
+        """``(row, Decision)`` of prepared ``items`` (render, compose and encode their panels)."""
+        panels = [None] * len(items)
+        if self.agent.observation == "panel" and items:
             from ignjax.sim.views.encode import encode_images
 
-            scene = np.asarray(states.episode.scene)[rows]
-            pose = np.asarray(states.pose)[rows]
-            v = self.renderer.render(scene, pose)
+            v = self.renderer.render(np.asarray([it["scene"] for it in items]),
+                                     np.stack([it["pose"] for it in items]))
             fmt = self.views.image_format
             data = encode_images(self.renderer.panels(v), fmt, self.views.quality)
             mime = "image/jpeg" if fmt == "jpeg" else "image/png"
             panels = [ImagePart(b, mime) for b in data]
+            rgb = list(v.rgb) if self.agent.uses_views else [None] * len(items)
+        else:
+            rgb = [None] * len(items)
         out = []
-        step = np.asarray(states.step)
-        qleft = np.asarray(obs["questions_left"])
-        for j, r in enumerate(rows):
-            ep = slots[r]
-            rec = self.es.records[ep.index]
-            text = None if self.agent.observation == "panel" else observation_text(obs, r, self.categories, self.names)
-            last_kind = ep.calls[-1]["action"][0] if ep.calls and ep.calls[-1].get("action") else -1
-            d = Decision(episode=rec["episode_id"], step=int(step[r]), max_steps=self.sim.max_steps,
-                         goal=vocab.category_display(rec["target_category"]), questions_left=int(qleft[r]),
-                         costs=self.costs, answers=tuple(ep.answers),
-                         last_move=" ".join(t for t in (_last_move_text(obs, r, last_kind), ep.progress) if t),
-                         n_views=self.sim.n_views, panel=panels[j], observation=text)
-            if panels[j] is not None and ep.index < self.save_images:
-                ep.images.append((int(step[r]), panels[j]))
-            out.append(d)
+        for it, panel, views in zip(items, panels, rgb):
+            ep = slots[it["row"]]
+            d = Decision(panel=panel, views=views, **it["decision"])
+            if panel is not None and ep.index < self.save_images:
+                ep.images.append((d.step, panel, "panel"))
+            out.append((it["row"], d))
         return out
 
     async def _decide(self, client: ChatClient, ep: _Episode, d: Decision):
-        """One decision: request, parse, re-ask; ``("act", tuple)`` or ``("fail", reason)``."""
-        agent = self.agent
-        req = agent.request(ep.memory, d)
+        """One decision (the agent's :meth:`~ignjax.agents.llm.agent.LLMAgent.decide`
+        with a :class:`_Context`): ``("act", tuple)`` or ``("fail", reason)``."""
+        ctx = _Context(self, client, ep, d)
+        first = len(ep.calls)
+        try:
+            act = tuple(int(x) for x in await self.agent.decide(ctx, ep.memory, d))
+        except LLMRequestError as e:
+            return "fail", str(e)
+        if len(ep.calls) == first:  # decided by the agent's controller alone: no model call
+            ep.calls.append(self._call(d, None, None, act, [], None, role="controller"))
+        ep.calls[-1]["action"] = list(act)
+        if ctx.defaulted:
+            ep.calls[-1]["error"] = "invalid replies: default action taken"
+        return "act", act
+
+    async def _query(self, client: ChatClient, ep: _Episode, d: Decision, req, parse, role: str, reasks: int):
+        """One model call with its re-asks: ``parse(parsed, parse_error) -> (value, error)``;
+        the value, or None when every reply was unusable (each counted invalid)."""
         earlier, res = [], None
-        for attempt in range(agent.reasks + 1):
+        for attempt in range(reasks + 1):
             try:
                 res = await client.complete(req)
             except LLMRequestError as e:
-                ep.calls.append(self._call(d, req, None, None, earlier, str(e)))
-                return "fail", str(e)
+                ep.calls.append(self._call(d, req, None, None, earlier, str(e), role=role))
+                raise
             ep.acc["requests"] += 0 if res.cache_hit else 1
             ep.acc["cache_hits"] += int(res.cache_hit)
             ep.acc["prompt_tokens"] += res.prompt_tokens
             ep.acc["completion_tokens"] += res.completion_tokens
             ep.acc["retries"] += res.retries
             ep.acc["model_latency_s"] += 0.0 if res.cache_hit else res.latency_s
-            act, err = agent.action(ep.memory, d, res.parsed, res.parse_error)
-            if act is not None:
-                ep.calls.append(self._call(d, req, res, act, earlier, None))
-                return "act", act
+            value, err = parse(res.parsed, res.parse_error)
+            if value is not None:
+                ep.calls.append(self._call(d, req, res, None, earlier, None, role=role))
+                return value
             ep.acc["invalid_replies"] += 1
             earlier.append({"reply": res.text, "error": err, "request_hash": res.request_hash})
-            if attempt < agent.reasks:
-                req = agent.correction(ep.memory, d, req, res.text, err)
-        act = agent.default_action(ep.memory, d)
-        ep.calls.append(self._call(d, req, res, act, earlier[:-1], "invalid replies: default action taken"))
-        return "act", act
+            if attempt < reasks:
+                req = self.agent.correction(ep.memory, d, req, res.text, err)
+        ep.calls.append(self._call(d, req, res, None, earlier[:-1], f"invalid replies: {earlier[-1]['error']}",
+                                   role=role))
+        return None
 
-    def _call(self, d: Decision, req, res, act, earlier, error) -> dict:
+    def _call(self, d: Decision, req, res, act, earlier, error, role: str = "planner") -> dict:
+        msgs = req.messages if req is not None else []
         text = "\n\n".join(p if isinstance(p, str) else p.get("text", "") if isinstance(p, dict) else f"[image {p.sha256[:12]}]"
-                           for m in req.messages for p in ([m["content"]] if isinstance(m["content"], str) else m["content"]))
-        images = [p.sha256 for m in req.messages if not isinstance(m["content"], str) for p in m["content"]
+                           for m in msgs for p in ([m["content"]] if isinstance(m["content"], str) else m["content"]))
+        images = [p.sha256 for m in msgs if not isinstance(m["content"], str) for p in m["content"]
                   if isinstance(p, ImagePart)]
-        return {"agent": self.agent.name, "episode": d.episode, "step": d.step, "role": "planner", "prompt": text,
+        return {"agent": self.agent.name, "episode": d.episode, "step": d.step, "role": role, "prompt": text,
                 "reply": res.text if res else "", "parsed": res.parsed if res else None, "retries": earlier,
                 "error": error, "action": list(act) if act else None,
                 "request_hash": res.request_hash if res else None, "images": images,
@@ -381,19 +466,30 @@ class HostLoop:
                 t_stats0 = client.stats()
                 states, need = fill(states, list(range(B)))
                 tasks: dict = {}
+                waiting: list[dict] = []  # rows prepared for a decision, not yet rendered
+                render = None  # the one render in progress (its rows' panels), or None
                 while True:
                     if need:
                         rows = sorted(need)
-                        obs = await loop.run_in_executor(None, lambda st=states: jax.tree.map(
-                            np.asarray, dataclasses.asdict(self._observe(st))))
-                        ds = await loop.run_in_executor(None, self._decisions, rows, slots, states, obs)
-                        for r, d in zip(rows, ds):
-                            tasks[asyncio.ensure_future(self._decide(client, slots[r], d))] = r
+                        waiting += await loop.run_in_executor(None, lambda st=states, rs=rows: self._prepare(
+                            rs, slots, st, jax.tree.map(np.asarray, dataclasses.asdict(self._observe(st)))))
                         need = []
-                    if not tasks:
+                    if waiting and render is None:
+                        # rendered while the loop keeps stepping rows whose replies arrive; rows that become
+                        # ready meanwhile are rendered together in the next call
+                        render = loop.run_in_executor(None, self._decisions, waiting, slots)
+                        waiting = []
+                    if not tasks and render is None:
                         break
-                    done, _ = await asyncio.wait(list(tasks), return_when=asyncio.FIRST_COMPLETED)
-                    ready = {tasks.pop(t): t.result() for t in done}
+                    done, _ = await asyncio.wait(list(tasks) + ([render] if render is not None else []),
+                                                 return_when=asyncio.FIRST_COMPLETED)
+                    if render in done:
+                        for r, d in render.result():
+                            tasks[asyncio.ensure_future(self._decide(client, slots[r], d))] = r
+                        render = None
+                    ready = {tasks.pop(t): t.result() for t in done if t in tasks}
+                    if not ready:
+                        continue
                     acts = np.zeros((B, 5), np.int32)
                     acts[:, 3] = 1
                     acts[:, 4] = 1
@@ -477,9 +573,9 @@ class HostLoop:
             return
         eid = self.es.records[ep.index]["episode_id"]
         folder = self.out / "images" / self.agent.name / eid
-        for step, img in ep.images:
+        for step, img, role in ep.images:
             ext = "jpg" if img.mime == "image/jpeg" else "png"
-            atomic_write(folder / f"{step:03d}_panel.{ext}", img.data)
+            atomic_write(folder / f"{step:03d}_{role}.{ext}", img.data)
 
     def _entry(self, ep: _Episode, outs: dict, r: int, steps: list, final_pose) -> dict:
         o = {k: np.asarray(getattr(outs, k))[r].tolist() for k in outs.__dataclass_fields__}

@@ -86,6 +86,19 @@ class Decision:
         n_views: views in the panel.
         panel: the Planner panel, encoded (None for text observations).
         observation: the symbolic observation as text (None with a panel).
+        views: the rendered views, (N, S, S, 3) uint8, for agents that show
+            one view on its own (the Grounder; :attr:`LLMAgent.uses_views`).
+        percept: what the agent's controller may read besides the prompt
+            (never shown to the model as numbers): ``open`` (8,) metres of free
+            floor in each of the observation's 8 sectors (view layout of 8,
+            whatever N), ``odometry`` (x, y) metres from the start (world
+            axes), ``room`` the room label code the
+            agent stands in (-1 unknown), ``known`` (4,) which answer types
+            were received, ``goal_room`` the Type-2 room label code (-1),
+            ``confirm`` the last Type-4 answer (1 yes, 0 no, -1 none),
+            ``follow_up`` (1 stop now, 2 one closer move, 0 none),
+            ``hint_active``, ``hint_progress`` (:data:`ignjax.sim.types.HINT_*`),
+            ``blocked`` (8,) bool sectors blocked in the last move.
     """
 
     episode: str
@@ -99,6 +112,8 @@ class Decision:
     n_views: int
     panel: ImagePart | None = None
     observation: str | None = None
+    views: object = None
+    percept: dict = field(default_factory=dict)
 
 
 @dataclass
@@ -118,6 +133,7 @@ class LLMAgent:
         reasks: corrections before the default action.
         show_costs: the prompt lists the question costs (the cost-aware setting).
         may_ask: the agent may ask questions at all.
+        uses_views: decisions carry the rendered views (:attr:`Decision.views`).
     """
 
     name = "llm"
@@ -126,12 +142,23 @@ class LLMAgent:
     reasks = 2
     show_costs = True
     may_ask = True
+    uses_views = False
 
     def start(self, episode: str) -> EpisodeMemory:
         return EpisodeMemory()
 
     def request(self, memory: EpisodeMemory, d: Decision) -> ChatRequest:
         raise NotImplementedError
+
+    async def decide(self, ctx, memory: EpisodeMemory, d: Decision):
+        """The action ``(kind, direction, col, row, question)`` of one
+        decision. ``ctx`` (given by the host loop) sends model calls with
+        re-asks (``await ctx.query(request, parse, role)``) and gives the
+        Grounder image of a view (``ctx.view_image(k)``). This single-stage
+        form: one planner request, parsed by :meth:`action`, the default
+        action when no reply is usable."""
+        act = await ctx.query(self.request(memory, d), lambda parsed, err: self.action(memory, d, parsed, err))
+        return act if act is not None else ctx.default(self.default_action(memory, d))
 
     def correction(self, memory: EpisodeMemory, d: Decision, previous: ChatRequest, reply: str, error: str) -> ChatRequest:
         """The same request with the faulty reply and a short correction appended."""

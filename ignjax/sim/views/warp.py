@@ -45,8 +45,11 @@ class WarpScene:
     def __init__(self, compiled: CompiledScene, n_views: int, hfov_deg: float, eye_height: float, size: int, nworld: int):
         import jax
         import jax.numpy as jnp
+        import warp
         from mujoco import mjx
 
+        # no start-up banner or per-module load lines on stdout (the bench prints JSON there)
+        warp.config.log_level = getattr(warp, "LOG_WARNING", 30)
         self.n_views, self.size, self.nworld, self.eye_height = n_views, size, nworld, float(eye_height)
         model, data = render_model(compiled, n_views, hfov_deg, size)
         self._ctx = mjx.create_render_context(
