@@ -3,6 +3,10 @@
 ``shared_data``: the folder ``../shared/data`` (real third-party data), or a
 skip with the reason when it is absent. The core suite never needs it.
 
+The session runs with two CPU devices (``ignjax.devices.configure_cpu_devices``,
+set here before JAX starts; ``IGNJAX_CPU_DEVICES`` overrides the count), so
+rollouts are sharded over two devices unless a test says otherwise.
+
 ``two_room_scene``: a small hand-built scene (living room + bedroom, one
 door) with known instances, for tests that need exact expectations.
 """
@@ -18,6 +22,10 @@ import pytest
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
+
+from ignjax.devices import configure_cpu_devices  # noqa: E402
+
+configure_cpu_devices(2)
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED_DATA = Path(os.environ.get("IGNJAX_SHARED_DATA", ROOT.parent / "shared" / "data"))

@@ -16,8 +16,13 @@ process, on the same inputs:
   accounting, no rendering) on the shipped benchmark for each JAX-native
   agent at B = 256, 1024, 4096 episodes; a decision step is one MOVE, ASK
   or STOP of an unfinished episode (best of three compiled calls). Each
-  batch runs as the default concurrent pieces (``rollout_parts``,
-  :func:`ignjax.sim.rollout.batch_parts`).
+  batch is sharded over every device (``rollout_parts``: the device count,
+  :func:`ignjax.sim.rollout.batch_parts`; on CPU one device per core,
+  ``IGNJAX_CPU_DEVICES`` to change it).
+* **scaling** - decision steps/s of the EIG agent at B = 4096 sharded over
+  1, 2 and all devices (``scaling.devices``), measured after compile in
+  turns (best of three each), so a machine shared with other work slows
+  them alike.
 * **compile_s** - first call of the EIG agent's rollout at B = 256.
 * **studies** - offline WSR of 10^6 cost vectors x 500 episodes, and the
   in-the-loop sweep (the EIG agent under K cost vectors x 500 episodes in
@@ -26,6 +31,7 @@ process, on the same inputs:
 
 ``--json``: the last line of stdout is one JSON object with every figure.
 ``--llm``: only the MLLM host loop's figures (:mod:`ignjax.bench.llm`).
+``--scaling``: only the scaling figures.
 
 The ray figures are :mod:`ignjax.bench.rays`, the rollout and study figures
 :mod:`ignjax.bench.rollouts`; this module is the command line.
@@ -37,7 +43,37 @@ import argparse
 import json
 import sys
 
-from ignjax.bench.timing import log
+from ignjax.bench.timing import log, time_interleaved
+
+SCALING_BATCH = 4096
+"""Episodes of the EIG rollout the scaling figures time."""
+SCALING_REPEATS = 3
+
+
+def bench_scaling(es, world, batch: int = SCALING_BATCH) -> dict:
+    """Decision steps/s of the EIG agent's rollout of ``batch`` episodes
+    sharded over 1, 2 and all devices (those there are), compiled first and
+    then timed in turns (:func:`ignjax.bench.timing.time_interleaved`).
+
+    Returns:
+        {"batch": batch, "devices": {str(count): steps/s}}.
+    """
+    import jax
+    import numpy as np
+
+    from ignjax.agents import get_agent
+    from ignjax.sim.rollout import episode_keys, rollout
+
+    agent = get_agent("eig")
+    params = agent.default_params()
+    idx = np.arange(batch) % len(es)
+    specs = jax.tree.map(lambda a: a[idx], es.specs)
+    keys = episode_keys(0, np.arange(batch))
+    counts = sorted({c for c in (1, 2, jax.device_count()) if c <= jax.device_count()})
+    runs = [lambda c=c: jax.block_until_ready(rollout(world, specs, agent, params, keys, parts=c)) for c in counts]
+    steps = {c: float(np.asarray(run()[0].steps).sum()) for c, run in zip(counts, runs)}  # compile
+    best = time_interleaved(runs, SCALING_REPEATS)
+    return {"batch": batch, "devices": {str(c): steps[c] / dt for c, dt in zip(counts, best)}}
 
 
 def main(argv=None) -> int:
@@ -46,6 +82,8 @@ def main(argv=None) -> int:
     p.add_argument("--quick", action="store_true", help="fewer rays, the EIG and random agents only, K = 16 in the loop")
     p.add_argument("--json", action="store_true", help="end stdout with one JSON line of every figure")
     p.add_argument("--episodes", help="episode file for the rollouts (default: the shipped benchmark)")
+    p.add_argument("--scaling", action="store_true",
+                   help=f"only the scaling figures (EIG agent, B = {SCALING_BATCH}, sharded over 1, 2 and all devices)")
     p.add_argument("--llm", action="store_true",
                    help="only the MLLM loop's figures (the llm block: batched vs sequential episodes per hour against "
                         "the local scripted server, utilisation, host ms per decision; ignjax.bench.llm)")
@@ -72,6 +110,10 @@ def main(argv=None) -> int:
         res["llm"] = bench_llm(load_benchmark(args.episodes or SHIPPED_BENCHMARK), args.quick)
         print(json.dumps(res, sort_keys=True) if args.json else json.dumps(res, indent=2, sort_keys=True))
         return 0
+    if args.scaling:
+        res["scaling"] = _scaling(load_benchmark(args.episodes or SHIPPED_BENCHMARK))
+        print(json.dumps(res, sort_keys=True) if args.json else json.dumps(res, indent=2, sort_keys=True))
+        return 0
     log("rays ...")
     res.update(bench_rays(args.quick))
     r = res["rays_per_s"]
@@ -90,9 +132,10 @@ def main(argv=None) -> int:
     agents = ("random", "eig") if args.quick else AGENTS
     sizes = (256, 1024, 4096)
     res["rollout_parts"] = {str(B): batch_parts(B) for B in sizes}
-    log("  each batch runs as " + ", ".join(f"{v} pieces at B = {k}" for k, v in res["rollout_parts"].items()))
+    log(f"  each batch sharded over {batch_parts()} {jax.default_backend()} devices")
     res["steps_per_s"], res["compile_s"] = bench_steps(es, world, agents, sizes)
     log(f"  EIG rollout compile {res['compile_s']:.1f} s")
+    res["scaling"] = _scaling(es, world)
     log("studies ...")
     res["studies"] = bench_studies(es, world, args.quick)
     if args.json:
@@ -100,6 +143,16 @@ def main(argv=None) -> int:
     else:
         print(json.dumps(res, indent=2, sort_keys=True))
     return 0
+
+
+def _scaling(es, world=None) -> dict:
+    """:func:`bench_scaling`, with its progress lines."""
+    from ignjax.evaluate.runner import make_world
+
+    log(f"scaling: EIG rollout at B = {SCALING_BATCH} over 1, 2 and all devices ...")
+    out = bench_scaling(es, world or make_world(es))
+    log("  " + ", ".join(f"{c} devices {v:.0f} decision steps/s" for c, v in out["devices"].items()))
+    return out
 
 
 if __name__ == "__main__":

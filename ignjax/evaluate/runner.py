@@ -2,10 +2,11 @@
 ``python -m ignjax.evaluate`` and the sweep's ``eval`` study).
 
 Episodes are run in chunks of ``batch`` (the last chunk padded with masked
-copies), so every chunk reuses one compiled rollout; each episode's PRNG key
+copies), so every chunk reuses one compiled rollout, sharded over the
+devices (:func:`ignjax.sim.rollout.rollout`); each episode's PRNG key
 comes from the seed and its index in the episode file, so its randomness
-does not depend on the batch size (float rounding can, in rare episodes:
-see :func:`ignjax.sim.rollout.batch_parts`).
+does not depend on the batch size (float rounding at other vectorised
+widths can, in rare episodes; the device count does not).
 """
 
 from __future__ import annotations
@@ -49,7 +50,8 @@ def episode_batches(es: EpisodeSet, batch: int, seed: int = 0, progress=None):
 def run_agent(es: EpisodeSet, agent: Agent | str, *, params=None, batch: int = 256, seed: int = 0,
               config: SimConfig = SimConfig(), progress=None, world: World | None = None, parts: int | None = None):
     """Roll out every episode of ``es`` with one agent, ``batch`` episodes per
-    rollout, each run as ``parts`` concurrent pieces (:func:`ignjax.sim.rollout.batch_parts`).
+    rollout, each sharded over ``parts`` devices (None or 0: every device;
+    :func:`ignjax.sim.rollout.batch_parts`). The results do not depend on ``parts``.
 
     Returns:
         (OutcomeRow, Trajectory) as numpy pytrees with leading axis len(es).

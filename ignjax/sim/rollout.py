@@ -5,13 +5,19 @@ of observe -> act -> step; finished episodes stay finished);
 :func:`rollout_rows` runs a batch of them with the same results row for row,
 paying only for the work each step's episodes need (the executor for the
 rows that MOVE, the oracle for the rows that ASK, nothing for finished
-rows); :func:`rollout` jits it once per (agent, piece shape), and
-:func:`rollout_sweep` runs K agent parameter settings x E episodes as one
-batch of K E rows (e.g. K cost vectors in one call). Both run a batch as
-concurrent pieces on CPU (:func:`batch_parts`), since XLA:CPU gives the
-body of a scan one core. The pieces share one compiled program (kept in a
-bounded, locked cache of :data:`MAX_EXECUTABLES` programs) and one
-process-wide pool of :data:`POOL_WORKERS` threads, made once under a lock.
+rows); :func:`rollout` runs a batch of E episodes with one agent, and
+:func:`rollout_sweep` K agent parameter settings x E episodes as one batch
+of K E rows (e.g. K cost vectors in one call). Both are one jitted program,
+compiled once per (agent, batch shape, device count), that shards the
+episodes over a 1-D mesh of devices (:func:`device_mesh`, axis
+:data:`AXIS`, with ``jax.shard_map``): the CPU devices of
+:func:`ignjax.devices.configure_cpu_devices` (XLA:CPU gives the body of a
+scan one core, so one device per core uses them all), several GPUs or a TPU
+slice alike. Each device runs its share of the episodes (and, in a sweep,
+every setting of them) with no communication; the batch is padded with
+finished copies to equal shards, and every row runs at the vectorised
+widths of the whole batch, so a row's result does not depend on the device
+count (tested bitwise).
 
 Agents are pure functions (:class:`ignjax.agents.Agent`): ``init`` and
 ``act`` see the :class:`~ignjax.sim.types.Observation` and the oracle's
@@ -32,14 +38,15 @@ anyway.
 from __future__ import annotations
 
 import dataclasses
-import threading
-from collections import OrderedDict
-from concurrent.futures import ThreadPoolExecutor
+import math
 from functools import partial
 
 import jax
 import jax.numpy as jnp
+import numpy as np
+from jax.sharding import Mesh, PartitionSpec as P
 
+from ignjax.errors import ConfigError
 from ignjax.sim import env as E
 from ignjax.sim import types as T
 from ignjax.sim.compact import chunk_size, even_chunk, first_equal, masked_map
@@ -112,111 +119,91 @@ def rollout_episode(world: World, spec: T.EpisodeSpec, agent, params, key: jax.A
 ROLLOUT_COMPILER_OPTIONS = {"xla_cpu_use_fusion_emitters": False}
 
 
-PARTS = 2
-"""Pieces a batch runs as at the same time on CPU, by default (:func:`batch_parts`)."""
-MIN_PART_ROWS = 64
-"""Smallest piece the default split makes."""
+AXIS = "episodes"
+"""Name of the device mesh axis the episodes are sharded over."""
 
 
-def batch_parts(n_rows: int, parts: int | None = None) -> int:
-    """How many equal pieces a rollout of ``n_rows`` rows runs as, each on its own thread.
-
-    XLA:CPU runs the body of a rollout's scan on one core, so a batch runs
-    fastest as several pieces executed at once (the EIG agent at B = 4096 on
-    a 2-core CPU: 1.7x). The default depends on the batch and the backend
-    only, never on the machine's core count, so that a configuration
-    compiles the same shapes everywhere: :data:`PARTS` pieces on CPU when
-    each gets at least :data:`MIN_PART_ROWS` rows, one otherwise and on
-    accelerators (where one program fills the device). Machines with more
-    cores profit from more pieces (``parts``). Each piece is the same
-    compiled program; a row's result depends on its episode, key and agent
-    parameters, and, through float rounding in rare rows, on the piece's
-    shape (as on the chunk size).
+def batch_parts(n_rows: int | None = None, parts: int | None = None) -> int:
+    """How many devices a rollout shards its episodes over.
 
     Args:
-        n_rows: rows of the batch.
-        parts: requested pieces (None: the default above).
+        n_rows: rows of the batch (unused: any batch is padded to a multiple
+            of the count; kept so callers can say which batch they mean).
+        parts: requested devices; None or 0: every device of the default
+            backend (``jax.devices()``: the GPUs, the TPU chips, or the CPU
+            devices of :func:`ignjax.devices.configure_cpu_devices`).
 
     Returns:
-        int in 1..n_rows.
+        int in 1..``jax.device_count()``.
+
+    Raises:
+        ConfigError: ``parts`` is negative or more than the devices there are.
     """
-    if parts is None:
-        parts = PARTS if jax.default_backend() == "cpu" and n_rows >= PARTS * MIN_PART_ROWS else 1
-    return max(1, min(int(parts), int(n_rows)))
+    available = jax.device_count()
+    if not parts:
+        if parts is not None and parts < 0:
+            raise ConfigError(None, "parts", f"must be >= 0 (0: every device), got {parts}")
+        return available
+    parts = int(parts)
+    if parts < 0 or parts > available:
+        raise ConfigError(None, "parts", f"must be in 0..{available} (devices to shard over; 0: all {available} "
+                          f"{jax.default_backend()} devices), got {parts}"
+                          + (" (more CPU devices: IGNJAX_CPU_DEVICES, set before JAX starts)"
+                             if jax.default_backend() == "cpu" and parts > available else ""))
+    return parts
 
 
-MAX_EXECUTABLES = 64
-"""Compiled rollout programs kept for the pieces (the least recently used is dropped first)."""
-POOL_WORKERS = 32
-"""Threads that run a batch's pieces (made as needed; pieces beyond them wait for a free one)."""
+def device_mesh(parts: int) -> Mesh:
+    """A 1-D mesh (axis :data:`AXIS`) over the first ``parts`` devices."""
+    return Mesh(np.array(jax.devices()[:parts]), (AXIS,))
 
 
-class _ExecutableCache:
-    """Compiled programs by key, at most ``maxsize`` of them (least recently
-    used dropped first); thread-safe, and a program is compiled once however
-    many threads ask for it at the same time."""
-
-    def __init__(self, maxsize: int):
-        self.maxsize = int(maxsize)
-        self._items: OrderedDict = OrderedDict()
-        self._lock = threading.Lock()
-
-    def __len__(self) -> int:
-        with self._lock:
-            return len(self._items)
-
-    def get(self, key, compile_fn):
-        """The program under ``key``, compiled by ``compile_fn()`` (under the lock) when absent."""
-        with self._lock:
-            exe = self._items.get(key)
-            if exe is None:
-                exe = self._items[key] = compile_fn()
-                while len(self._items) > self.maxsize:
-                    self._items.popitem(last=False)
-            else:
-                self._items.move_to_end(key)
-            return exe
+def _widths(rows: int, episodes: int, chunk: int | None) -> tuple[int, int, int]:
+    """The vectorised widths of a batch of ``rows`` rows (``episodes``
+    distinct episodes): the agent's chunk, the simulator's chunk and, for a
+    sweep, the simulator's chunk in group mode (:func:`rollout_rows`)."""
+    act = even_chunk(rows, chunk or chunk_size(rows))
+    sim = min(chunk or chunk_size(rows), rows)
+    group = min(chunk or chunk_size(episodes), rows)
+    return act, sim, group
 
 
-_EXECUTABLES = _ExecutableCache(MAX_EXECUTABLES)
-_POOL: ThreadPoolExecutor | None = None
-_POOL_LOCK = threading.Lock()
+def _shard_rows(n: int, copies: int, parts: int, widths: tuple[int, int, int]) -> int:
+    """Episodes per device when ``n`` episodes (each run ``copies`` times)
+    are sharded over ``parts`` devices at these ``widths``: at least its share
+    of ``n``, and enough, with ``copies``, for whole agent chunks and a full
+    simulator chunk, so that every row runs at the widths of the whole batch."""
+    act, sim, group = widths
+    m = max(-(-n // parts), -(-max(sim, group) // copies))
+    step = act // math.gcd(act, copies)
+    return -(-m // step) * step
 
 
-def _executable(jitted, dynamic: tuple, static: dict):
-    """The compiled ``jitted`` for these arguments, compiled once (so that
-    pieces started together do not each compile it)."""
-    leaves, tree = jax.tree.flatten(dynamic)
-    key = (jitted, tuple(sorted(static.items())), tree, tuple(jax.typeof(x) for x in leaves))
-    return _EXECUTABLES.get(key, lambda: jitted.lower(*dynamic[:2], static["agent"], *dynamic[2:],
-                                                      chunk=static["chunk"]).compile())
-
-
-def _pool() -> ThreadPoolExecutor:
-    """The process's one pool of :data:`POOL_WORKERS` threads for pieces, made on first use."""
-    global _POOL
-    with _POOL_LOCK:
-        if _POOL is None:
-            _POOL = ThreadPoolExecutor(POOL_WORKERS, thread_name_prefix="ignjax-rollout")
-        return _POOL
-
-
-def _in_parts(jitted, world, specs, agent, params, keys, chunk, parts: int, out_axis: int):
-    """``jitted(world, specs, agent, params, keys, chunk)`` over ``parts``
-    equal pieces of the episode axis run at the same time (the last padded
-    with finished copies), concatenated along ``out_axis``."""
+def _sharded(fn, world, specs, agent, params, keys, chunk, parts: int, copies: int, out_axis: int):
+    """``fn(world, specs, agent, params, keys, widths)`` with the episode axis
+    of ``specs`` and ``keys`` split over ``parts`` devices, each episode run
+    ``copies`` times (a sweep's settings). The episodes are padded with
+    finished copies to ``parts`` equal shards (:func:`_shard_rows`); the
+    outputs' episode axis is ``out_axis``, and the padding is cut from it."""
     n = specs.scene.shape[0]
-    dynamic = (world, specs, params, keys)
-    if parts <= 1 or any(isinstance(x, jax.core.Tracer) for x in jax.tree.leaves(dynamic)):
-        return jitted(world, specs, agent, params, keys, chunk)
-    size = -(-n // parts)
-    specs, keys = pad_batch(specs, keys, size * parts)
-    pieces = [(world, jax.tree.map(lambda a: a[i * size:(i + 1) * size], specs), params, keys[i * size:(i + 1) * size])
-              for i in range(parts)]
-    exe = _executable(jitted, pieces[0], {"agent": agent, "chunk": chunk})
-    futures = [_pool().submit(lambda p: jax.block_until_ready(exe(*p)), p) for p in pieces]
-    outs = [f.result() for f in futures]
-    return jax.tree.map(lambda *xs: jax.lax.slice_in_dim(jnp.concatenate(xs, out_axis), 0, n, axis=out_axis), *outs)
+    widths = _widths(n * copies, n, chunk)
+    size = _shard_rows(n, copies, parts, widths) * parts
+    specs, keys = pad_batch(specs, keys, size)
+    out = _run_sharded(world, specs, params, keys, fn=fn, agent=agent, widths=widths, mesh=device_mesh(parts),
+                       out_axis=out_axis)
+    if size == n:
+        return out
+    return jax.tree.map(lambda a: jax.lax.slice_in_dim(a, 0, n, axis=out_axis), out)
+
+
+@partial(jax.jit, static_argnames=("fn", "agent", "widths", "mesh", "out_axis"),
+         compiler_options=ROLLOUT_COMPILER_OPTIONS)
+def _run_sharded(world, specs, params, keys, *, fn, agent, widths, mesh: Mesh, out_axis: int):
+    rows = P(AXIS)
+    out = P(*([None] * out_axis + [AXIS]))
+    run = jax.shard_map(lambda w, s, p, k: fn(w, s, agent, p, k, widths), mesh=mesh,
+                        in_specs=(P(), rows, P(), rows), out_specs=out, check_vma=False)
+    return run(world, specs, params, keys)
 
 
 def episode_keys(seed: int, indices) -> jax.Array:
@@ -231,7 +218,7 @@ def _keys(key: jax.Array, n: int) -> jax.Array:
 
 
 def rollout_rows(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.Array, chunk: int | None = None,
-                 groups: jax.Array | None = None, group_chunk: int | None = None):
+                 groups: jax.Array | None = None, group_chunk: int | None = None, act_chunk: int | None = None):
     """Run a batch of episodes (leading axis B) with per-row agent parameters.
 
     Row for row the same as :func:`rollout_episode` (tested), organised so
@@ -258,6 +245,8 @@ def rollout_rows(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.Ar
         group_chunk: rows per vectorised call of the simulator in group mode
             (default: ``chunk``); size it to the number of distinct
             trajectories, not to the batch.
+        act_chunk: rows per vectorised call of the agent (default: the
+            divisor of B nearest below ``chunk``, :func:`ignjax.sim.compact.even_chunk`).
 
     Returns:
         (OutcomeRow, Trajectory, final SimState) with leading axis B.
@@ -271,7 +260,7 @@ def rollout_rows(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.Ar
     privileged = (lambda st: E.privileged_info(world, st)) if agent.privileged else None
     priv0 = jax.vmap(privileged)(state) if privileged else None
     act = lambda x: agent.act(*x)  # noqa: E731
-    act_chunk = even_chunk(keys.shape[0], chunk or chunk_size(keys.shape[0]))
+    act_chunk = act_chunk or even_chunk(keys.shape[0], chunk or chunk_size(keys.shape[0]))
 
     def simulate(state, obs, priv, action, moved, sim_chunk):
         state = E.step_batch(world, state, action, sim_chunk)
@@ -308,23 +297,23 @@ def rollout_rows(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.Ar
     return jax.vmap(lambda st: E.outcome(world, st))(state), traj, state
 
 
-@partial(jax.jit, static_argnames=("agent", "chunk"), compiler_options=ROLLOUT_COMPILER_OPTIONS)
-def _rollout(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.Array, chunk: int | None = None):
+def _rollout(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.Array, widths: tuple):
+    """One device's share of :func:`rollout`."""
     n = specs.scene.shape[0]
+    act, sim, _ = widths
     rows = jax.tree.map(lambda x: jnp.broadcast_to(x, (n,) + jnp.shape(x)), params)
-    return rollout_rows(world, specs, agent, rows, keys, chunk)[:2]
+    return rollout_rows(world, specs, agent, rows, keys, sim, act_chunk=act)[:2]
 
 
-@partial(jax.jit, static_argnames=("agent", "chunk"), compiler_options=ROLLOUT_COMPILER_OPTIONS)
-def _rollout_sweep(world: World, specs: T.EpisodeSpec, agent, params_batch, keys: jax.Array,
-                   chunk: int | None = None):
+def _rollout_sweep(world: World, specs: T.EpisodeSpec, agent, params_batch, keys: jax.Array, widths: tuple):
+    """One device's share of :func:`rollout_sweep`: its episodes under every setting."""
     n = specs.scene.shape[0]
+    act, sim, group = widths
     K = jax.tree.leaves(params_batch)[0].shape[0]
     rows = jax.tree.map(lambda x: jnp.repeat(x, n, axis=0), params_batch)
     tile = jnp.tile(jnp.arange(n), K)
-    sim_chunk = chunk if chunk is not None else chunk_size(n)
-    out = rollout_rows(world, jax.tree.map(lambda a: a[tile], specs), agent, rows, keys[tile], chunk,
-                       groups=tile, group_chunk=sim_chunk)[:2]
+    out = rollout_rows(world, jax.tree.map(lambda a: a[tile], specs), agent, rows, keys[tile], sim,
+                       groups=tile, group_chunk=group, act_chunk=act)[:2]
     return jax.tree.map(lambda a: a.reshape((K, n) + a.shape[1:]), out)
 
 
@@ -332,21 +321,29 @@ def rollout(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.Array, 
             parts: int | None = None):
     """Run a batch of episodes (leading axis E of ``specs``) with one agent.
 
-    One jitted program, compiled once per agent and piece shape: the batch
-    runs as ``parts`` equal pieces at the same time (:func:`batch_parts`).
+    One jitted program, compiled once per agent, batch shape and device
+    count, with the episodes sharded over ``parts`` devices. E need not
+    divide by ``parts``: the batch is padded with finished copies of the
+    last episode, which are cut from the result. Each row's result is the
+    same whatever ``parts`` is.
 
     Args:
         keys: (E,) per-episode keys (see :func:`episode_keys`), or one key
             that is split.
-        chunk: rows per vectorised call within a piece (:func:`rollout_rows`).
-        parts: concurrent pieces of the batch (default :func:`batch_parts`).
+        chunk: rows per vectorised call (:func:`rollout_rows`; default: an
+            eighth of the whole batch, whatever the device count).
+        parts: devices to shard over: None or 0 for every device
+            (``jax.devices()``), else 1 up to their number (:func:`batch_parts`).
 
     Returns:
         (OutcomeRow, Trajectory) with leading axis E.
+
+    Raises:
+        ConfigError: ``parts`` is negative or more than the devices there are.
     """
     n = specs.scene.shape[0]
     keys = _keys(keys, n)
-    return _in_parts(_rollout, world, specs, agent, params, keys, chunk, batch_parts(n, parts), 0)
+    return _sharded(_rollout, world, specs, agent, params, keys, chunk, batch_parts(n, parts), 1, 0)
 
 
 def rollout_sweep(world: World, specs: T.EpisodeSpec, agent, params_batch, keys: jax.Array, chunk: int | None = None,
@@ -354,8 +351,9 @@ def rollout_sweep(world: World, specs: T.EpisodeSpec, agent, params_batch, keys:
     """Run every episode under every parameter setting (leading axis K of
     ``params_batch``): K x E episodes in one call, as one batch of K E rows,
     the same key per episode across settings (paired comparisons). The
-    episodes are split into ``parts`` concurrent pieces (each with every
-    setting; :func:`batch_parts` of the K E rows).
+    episodes (axis E) are sharded over ``parts`` devices, each device running
+    its episodes under every setting; ``parts``, ``chunk`` and the padding
+    are as in :func:`rollout` (``chunk``'s default counts the K E rows).
 
     Returns:
         (OutcomeRow, Trajectory) with leading axes (K, E).
@@ -363,19 +361,19 @@ def rollout_sweep(world: World, specs: T.EpisodeSpec, agent, params_batch, keys:
     n = specs.scene.shape[0]
     keys = _keys(keys, n)
     K = jax.tree.leaves(params_batch)[0].shape[0]
-    return _in_parts(_rollout_sweep, world, specs, agent, params_batch, keys, chunk,
-                     min(batch_parts(n * K, parts), n), 1)
+    return _sharded(_rollout_sweep, world, specs, agent, params_batch, keys, chunk, batch_parts(n, parts), K, 1)
 
 
 def pad_specs(specs: T.EpisodeSpec, size: int) -> T.EpisodeSpec:
     """Pad a batch of specs to ``size`` rows with invalid copies of the last
-    row (padding rows start finished and are masked out of every metric)."""
+    row (padding rows start finished and are masked out of every metric;
+    rows that were already padding stay padding)."""
     n = specs.scene.shape[0]
     if n >= size:
         return specs
     idx = jnp.concatenate([jnp.arange(n), jnp.full(size - n, n - 1)])
     out = jax.tree.map(lambda a: a[idx], specs)
-    return dataclasses.replace(out, valid=jnp.arange(size) < n)
+    return dataclasses.replace(out, valid=out.valid & (jnp.arange(size) < n))
 
 
 def pad_batch(specs: T.EpisodeSpec, keys: jax.Array, size: int) -> tuple[T.EpisodeSpec, jax.Array]:

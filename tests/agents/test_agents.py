@@ -28,8 +28,7 @@ from ignjax.protocol import CONFIRM_RANGE, LOCKED_COSTS
 from ignjax.sim import env as E
 from ignjax.sim import types as T
 from ignjax.sim.rollout import (
-    _EXECUTABLES, MIN_PART_ROWS, PARTS, ROLLOUT_COMPILER_OPTIONS, _in_parts, batch_parts, episode_keys,
-    pad_specs, rollout, rollout_episode, rollout_rows, rollout_sweep,
+    ROLLOUT_COMPILER_OPTIONS, episode_keys, pad_specs, rollout, rollout_episode, rollout_rows, rollout_sweep,
 )
 from ignjax.sim.types import Privileged
 
@@ -283,51 +282,14 @@ def test_visit_counts_saturate_instead_of_wrapping(small_benchmark, small_world)
     assert int(full.visits[ij[1], ij[0]]) == 255
 
 
-def test_batch_parts_depend_on_the_batch_and_backend_only():
-    cpu = jax.default_backend() == "cpu"
-    assert batch_parts(PARTS * MIN_PART_ROWS) == (PARTS if cpu else 1)
-    assert batch_parts(PARTS * MIN_PART_ROWS - 1) == 1
-    assert batch_parts(1000, 8) == 8 and batch_parts(3, 8) == 3 and batch_parts(50, 0) == 1
-
-
-def test_pieces_are_split_padded_and_joined_in_order(small_benchmark, small_world):
-    """A batch run in pieces (the last padded with finished copies) gives
-    each row what one call on the whole batch gives it, on both output layouts."""
-    @partial(jax.jit, static_argnames=("agent", "chunk"))
-    def rows(world, specs, agent, params, keys, chunk=None):
-        v = specs.field * 1000 + specs.target * 10 + specs.valid + jax.random.randint(keys[0], (), 0, 3) * 0
-        return v * params, jax.random.key_data(keys)
-
-    @partial(jax.jit, static_argnames=("agent", "chunk"))
-    def settings(world, specs, agent, params, keys, chunk=None):
-        return (params[:, None] * (specs.field * 1000 + specs.target)[None],)
-
-    es = small_benchmark["set"]
-    specs, keys = _batch(es)
-    n = specs.scene.shape[0]
-    before = len(_EXECUTABLES)
-    for parts in (2, 3, 7):
-        got = _in_parts(rows, small_world, specs, "toy", jnp.int32(3), keys, None, parts, 0)
-        chex.assert_trees_all_equal(got, rows(small_world, specs, "toy", jnp.int32(3), keys))
-        assert got[0].shape == (n,)
-    assert len(_EXECUTABLES) == before + 3  # one program per piece shape, however many pieces run it
-    k = jnp.arange(1, 5, dtype=jnp.int32)
-    got = _in_parts(settings, small_world, specs, "toy", k, keys, None, 3, 1)
-    chex.assert_trees_all_equal(got, settings(small_world, specs, "toy", k, keys))
-    # under a trace the pieces are not split (the caller's program holds the whole batch)
-    shape = jax.eval_shape(lambda s, kk: _in_parts(rows, small_world, s, "toy", jnp.int32(3), kk, None, 3, 0), specs, keys)
-    assert shape[0].shape == (n,)
-
-
-def test_rollout_in_pieces_gives_each_episode_its_own_result(small_benchmark, small_world, runs):
-    """A rollout as two concurrent pieces: the episodes' results match the
-    one-piece rollout (up to float rounding, as between chunk widths) and
-    repeat exactly."""
+def test_rollout_on_one_device_gives_each_episode_the_same_result(small_benchmark, small_world, runs):
+    """The rollouts above are sharded over every device (two in the test
+    session); on one device each episode's result is the same, exactly, and
+    repeats exactly."""
     es = small_benchmark["set"]
     specs, keys = _batch(es)
     agent = get_agent("naive_asker")
-    got = jax.tree.map(np.asarray, rollout(small_world, specs, agent, agent.default_params(), keys, parts=2))
-    again = jax.tree.map(np.asarray, rollout(small_world, specs, agent, agent.default_params(), keys, parts=2))
+    got = jax.tree.map(np.asarray, rollout(small_world, specs, agent, agent.default_params(), keys, parts=1))
+    again = jax.tree.map(np.asarray, rollout(small_world, specs, agent, agent.default_params(), keys, parts=1))
     chex.assert_trees_all_equal(got, again)
-    same = _rows_matching(got, runs["naive_asker"])
-    assert same.mean() >= 0.95, np.flatnonzero(~same)
+    chex.assert_trees_all_equal(got, runs["naive_asker"])

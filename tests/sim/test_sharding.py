@@ -1,0 +1,119 @@
+"""Rollouts sharded over devices: the session has two CPU devices
+(tests/conftest.py), and a rollout or a sweep sharded over both gives, bit
+for bit, what the same call on one device gives, for a batch that divides
+by two and one that does not (padded, and the padding cut off). Also the
+device count setting (:func:`ignjax.devices.configure_cpu_devices`), the
+``parts`` check and the shard sizes."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import chex
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from ignjax.agents import get_agent
+from ignjax.devices import ENV_VAR, configure_cpu_devices
+from ignjax.errors import ConfigError
+from ignjax.protocol import LOCKED_COSTS
+from ignjax.sim.rollout import _shard_rows, _widths, batch_parts, episode_keys, pad_specs, rollout, rollout_sweep
+
+two_devices = pytest.mark.skipif(jax.device_count() < 2, reason=f"needs 2 devices (set {ENV_VAR}=2 or more)")
+
+
+def _batch(es, n: int):
+    """The first ``n`` episodes of the set and their keys."""
+    specs = jax.tree.map(lambda a: a[:n], es.specs)
+    return pad_specs(specs, n), episode_keys(0, np.arange(n))
+
+
+def _host(tree):
+    return jax.tree.map(np.asarray, tree)
+
+
+def test_configure_cpu_devices_once_jax_has_started(monkeypatch):
+    have = jax.local_device_count("cpu")
+    monkeypatch.delenv(ENV_VAR, raising=False)
+    assert configure_cpu_devices(have) == have  # the count the backends have: nothing to change
+    with pytest.warns(RuntimeWarning, match="already initialised"):
+        assert configure_cpu_devices(have + 1) is None
+    monkeypatch.setenv(ENV_VAR, str(have))  # the environment wins over the argument
+    assert configure_cpu_devices(have + 1) == have
+    monkeypatch.setenv(ENV_VAR, "two")
+    with pytest.raises(ValueError, match=ENV_VAR):
+        configure_cpu_devices()
+    monkeypatch.delenv(ENV_VAR)
+    with pytest.raises(ValueError, match="n: expected a positive integer"):
+        configure_cpu_devices(0)
+    assert jax.local_device_count("cpu") == have
+
+
+def test_parts_counts_devices():
+    d = jax.device_count()
+    assert batch_parts(100) == batch_parts(100, 0) == d
+    assert batch_parts(3, 1) == 1 and batch_parts(1, d) == d  # a batch smaller than the devices is padded, not refused
+    for bad in (d + 1, -1):
+        with pytest.raises(ConfigError, match=r"^parts: must be in 0\.\.") as e:
+            batch_parts(100, bad)
+        assert str(bad) in str(e.value)
+
+
+@pytest.mark.parametrize("n, copies, parts, chunk", [
+    (40, 1, 1, None), (39, 1, 2, None), (37, 1, 2, None), (40, 3, 2, 8), (39, 2, 2, None), (5, 1, 2, 8),
+    (4096, 1, 2, None), (500, 16, 4, None), (3, 1, 16, None), (1, 4, 2, None),
+])
+def test_shards_hold_whole_chunks_of_the_batch_widths(n, copies, parts, chunk):
+    """Every shard holds its share of the episodes, whole agent chunks and at
+    least one simulator chunk, at the widths of the whole batch; one device
+    pads nothing when the agent's chunk divides the rows."""
+    act, sim, group = _widths(n * copies, n, chunk)
+    m = _shard_rows(n, copies, parts, (act, sim, group))
+    assert m * parts >= n
+    assert (m * copies) % act == 0 and m * copies >= max(sim, group)
+    assert m * parts - n < parts * act + max(sim, group)  # padding is bounded by the chunk sizes
+    if parts == 1 and (n * copies) % act == 0 and n * copies >= max(sim, group):
+        assert m == n
+
+
+def test_padding_keeps_padded_rows_padded(small_benchmark):
+    specs = small_benchmark["set"].specs
+    specs = dataclasses.replace(jax.tree.map(lambda a: a[:4], specs), valid=jnp.array([True, True, False, True]))
+    got = pad_specs(specs, 6)
+    assert np.asarray(got.valid).tolist() == [True, True, False, True, False, False]
+    np.testing.assert_array_equal(np.asarray(got.target)[4:], np.asarray(specs.target)[[3, 3]])
+
+
+@two_devices
+@pytest.mark.parametrize("n", [40, 39])
+def test_rollout_on_two_devices_equals_one_device(small_benchmark, small_world, n):
+    es = small_benchmark["set"]
+    specs, keys = _batch(es, n)
+    agent = get_agent("naive_asker")
+    params = agent.default_params()
+    one = _host(rollout(small_world, specs, agent, params, keys, parts=1))
+    two = _host(rollout(small_world, specs, agent, params, keys, parts=2))
+    chex.assert_trees_all_equal(two, one)
+    assert one[0].steps.shape == (n,) and one[1].kind.shape[0] == n
+    assert np.asarray(one[0].valid).all()  # no padding row in the result
+    assert len(set(np.asarray(one[0].steps).tolist())) > 3  # the episodes differ: a shuffle would show
+
+
+@two_devices
+@pytest.mark.parametrize("n", [39])
+def test_sweep_on_two_devices_equals_one_device(small_benchmark, small_world, n):
+    es = small_benchmark["set"]
+    specs, keys = _batch(es, n)
+    eig = get_agent("eig")
+    K = 2
+    params = jax.tree.map(lambda x: jnp.broadcast_to(x, (K,) + jnp.shape(x)), eig.default_params())
+    costs = jnp.asarray(LOCKED_COSTS, jnp.float32)[None] * jnp.asarray([0.5, 4.0], jnp.float32)[:, None]
+    params = dataclasses.replace(params, costs=costs)
+    one = _host(rollout_sweep(small_world, specs, eig, params, keys, parts=1))
+    two = _host(rollout_sweep(small_world, specs, eig, params, keys, parts=2))
+    chex.assert_trees_all_equal(two, one)
+    assert one[0].steps.shape == (K, n) and one[1].kind.shape[:2] == (K, n)
+    q = np.asarray(one[0].n_questions).sum(-1)
+    assert q[0].sum() > q[1].sum()  # the settings differ, so a swap of the K axis would show
