@@ -33,7 +33,7 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from ignjax.agents import registry
-from ignjax.agents.llm.agent import LLM_AGENTS, get_llm_agent
+from ignjax.agents.llm.catalog import LLM_AGENTS, get_llm_agent
 from ignjax.agents.llm.config import LLMConfig
 from ignjax.agents.params import check_param_value, make_params, param_docs, param_values
 from ignjax.arrays import field_docs, parse_assignment
@@ -154,7 +154,7 @@ class EvalConfig:
 
     Attributes:
         agents: the agents evaluated: JAX-native agents (``ignjax.agents.registry()``) and MLLM agents
-            (``ignjax.agents.llm.agent.LLM_AGENTS``, e.g. ``vlm``; they need the ``[llm]`` table's server).
+            (``ignjax.agents.llm.catalog.LLM_AGENTS``, e.g. ``vlm``; they need the ``[llm]`` table's server).
         batch: episodes per compiled rollout.
         parts: concurrent pieces of each batch; 0: the default split (``ignjax.sim.rollout.batch_parts``, 2 on CPU).
         thresholds: success distances tau of the SR / OSR / WSR columns, m; positive and increasing.
@@ -348,7 +348,7 @@ class AgentsConfig:
     def used(self, names) -> dict[str, dict[str, Any]]:
         """``name -> parameters`` of the agents ``names`` (for run.json and report headers); an MLLM agent's
         options."""
-        return {n: dict(self.params[n]) if n in self.params else dict(vars(get_llm_agent(n)))
+        return {n: dict(self.params[n]) if n in self.params else {k: v for k, v in vars(get_llm_agent(n)).items() if k not in ('name', 'description')}
                 for n in dict.fromkeys(names)}
 
 

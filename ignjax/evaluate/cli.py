@@ -39,7 +39,7 @@ from ignjax.protocol import LOCKED_COSTS, SUCCESS_THRESHOLDS
 def build_parser() -> argparse.ArgumentParser:
     # imported on use, so that --help and the other commands answer at once
     from ignjax.agents import registry
-    from ignjax.agents.llm.agent import LLM_AGENTS
+    from ignjax.agents.llm.catalog import LLM_AGENTS
 
     agents = registry()
     p = argparse.ArgumentParser(prog="python -m ignjax.evaluate", description=__doc__.split("\n\n")[0],
@@ -79,6 +79,9 @@ def build_parser() -> argparse.ArgumentParser:
                                                              "the request's hash")
     g.add_argument("--llm-concurrency", type=int, default=None, help="requests in flight per endpoint (default 16)")
     g.add_argument("--llm-batch", type=int, default=64, help="episodes in flight at once (default 64)")
+    g.add_argument("--dry-run", action="store_true",
+                   help="print what the MLLM agents would send (requests, images, estimated tokens and cost) and exit "
+                        "without sending anything or loading scenes")
     g.add_argument("--save-images", type=int, default=0, metavar="N",
                    help="write the panels of the first N episodes to OUT/images (for python -m ignjax.view)")
     return p
@@ -154,6 +157,24 @@ def llm_settings(args, sections: dict, out_dir: Path):
     return llm, views
 
 
+def _dry_run(args, agents, llm_agents, sim, llm, views, costs) -> int:
+    """``--dry-run``: the upper bounds of :func:`ignjax.evaluate.hostloop.dry_run` per MLLM agent, as JSON lines."""
+    from ignjax.agents.llm.client import price
+    from ignjax.episodes.schema import read_episodes
+    from ignjax.evaluate.hostloop import dry_run
+
+    n = len(read_episodes(args.episodes))
+    n = min(n, args.limit) if args.limit else n
+    for agent in agents:
+        if agent not in llm_agents:
+            print(json.dumps({"agent": agent.name, "requests": 0, "note": "JAX-native: no model calls"}))
+            continue
+        est = dry_run(agent, n, sim=sim, views=views, llm=llm, costs=costs)
+        est["cost_usd_at_most"] = price(est["prompt_tokens"], est["completion_tokens_at_most"], llm.prices)
+        print(json.dumps(est))
+    return 0
+
+
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     try:
@@ -176,7 +197,7 @@ def run(args) -> int:
     from ignjax.evaluate.outcomes import (TRAJECTORY_FILE, metric_rows, model_totals, outcome_rows,
                                           write_metric_table, write_outcomes, write_trajectories)
 
-    from ignjax.agents.llm.agent import LLM_AGENTS, get_llm_agent
+    from ignjax.agents.llm.catalog import LLM_AGENTS, get_llm_agent
     from ignjax.evaluate.hostloop import run_llm_agent, write_transcripts
 
     agents = [get_llm_agent(a) if a in LLM_AGENTS else get_agent(a) for a in args.agent]
@@ -194,6 +215,8 @@ def run(args) -> int:
         raise ConfigError(None, "--batch", f"must be >= 1, got {args.batch}")
     if args.parts < 0:
         raise ConfigError(None, "--parts", f"must be >= 0, got {args.parts}")
+    if args.dry_run:
+        return _dry_run(args, agents, llm_agents, sim, llm, views, costs)
     t0 = time.perf_counter()
     es = load_benchmark(args.episodes, args.scenes_root, limit=args.limit or None)
     world = make_world(es, sim)

@@ -447,6 +447,9 @@ class HostLoop:
                     break
                 i = queue.pop()
                 slots[r] = _Episode(i, self.agent.start(self.es.records[i]["episode_id"]))
+                if self.sim.upfront_description:  # given at reset (and charged) as one Type-1 and one Type-2 answer
+                    o = self.es.records[i]["oracle"]
+                    slots[r].answers = [(1, o["appearance"]), (2, o["region"])]
                 traj_rows[i] = []
                 rows.append(r)
                 idx.append(i)
@@ -630,6 +633,59 @@ class HostLoop:
         return LoopResult(outcomes=outcomes, trajectories=traj, accounting=acc, stats=stats, transcripts=calls)
 
 
+IMAGE_TOKEN_PX = 28
+"""Side of the image patch one vision token covers in the dry-run estimate (Qwen2-VL-style models: 14 px patches
+merged 2x2); other models count differently, so the figure is an estimate."""
+
+
+def dry_run(agent: LLMAgent, n_episodes: int, *, sim: T.SimConfig = T.SimConfig(), views: ViewConfig = ViewConfig(size=224),
+            llm: LLMConfig | None = None, costs=LOCKED_COSTS) -> dict:
+    """What running ``agent`` on ``n_episodes`` episodes would send at most,
+    before sending anything: requests (every decision a Planner call, every
+    decision a move for two-stage agents; re-asks not counted), images, and
+    an estimate of prompt tokens (text at 4 characters a token, images at one
+    token per :data:`IMAGE_TOKEN_PX` square) and of completion tokens
+    (``llm.max_tokens`` per request, the cap). The prompts are built from a
+    first decision of an episode with no answers yet."""
+    from ignjax.sim.views.compose import panel_layout
+
+    sim = dataclasses.replace(sim, **dict(getattr(agent, "sim_overrides", {}) or {}))
+    two_stage = bool(getattr(agent, "two_stage", False)) and agent.observation == "panel"
+    img = ImagePart(b"\xff\xd8\xff\xd9") if agent.observation == "panel" else None
+    d = Decision(episode="dry-run", step=0, max_steps=sim.max_steps, goal="object", questions_left=sim.max_questions,
+                 costs=tuple(costs), answers=(), last_move="", n_views=sim.n_views, panel=img,
+                 observation=None if img is not None else "\n".join(f"- view {k}: open floor for about 2.0 m; nothing of "
+                                                                     "note" for k in range(sim.n_views)),
+                 percept={})
+    memory = agent.start("dry-run")
+    req = agent.planner_request(memory, d) if hasattr(agent, "planner_request") else agent.request(memory, d)
+
+    def text_tokens(r) -> int:
+        chars = sum(len(p) if isinstance(p, str) else len(p.get("text", "")) if isinstance(p, dict) else 0
+                    for m in r.messages for p in ([m["content"]] if isinstance(m["content"], str) else m["content"]))
+        return chars // 4 + len(json.dumps(r.schema or {})) // 4
+
+    rows, cols, _ = panel_layout(sim.n_views)
+    panel_tokens = (rows * views.size // IMAGE_TOKEN_PX) * (cols * views.size // IMAGE_TOKEN_PX)
+    view_tokens = (views.size // IMAGE_TOKEN_PX) ** 2
+    decisions = n_episodes * sim.max_steps
+    planner_tokens = text_tokens(req) + (panel_tokens if img is not None else 0)
+    out = {"agent": agent.name, "episodes": n_episodes, "decisions_at_most": decisions,
+           "planner_requests": decisions, "grounder_requests": decisions if two_stage else 0,
+           "images": (decisions if img is not None else 0) + (decisions if two_stage else 0),
+           "prompt_tokens_per_planner_request": planner_tokens}
+    grounder_tokens = 0
+    if two_stage:
+        g = agent.grounder_request(d, ImagePart(b"\xff\xd8\xff\xd9"), "the centre of the open doorway", "")
+        grounder_tokens = text_tokens(g) + view_tokens
+        out["prompt_tokens_per_grounder_request"] = grounder_tokens
+    out["requests"] = out["planner_requests"] + out["grounder_requests"]
+    out["prompt_tokens"] = decisions * planner_tokens + out["grounder_requests"] * grounder_tokens
+    max_tokens = (llm.max_tokens if llm is not None else LLMConfig().max_tokens)
+    out["completion_tokens_at_most"] = out["requests"] * max_tokens
+    return out
+
+
 def run_llm_agent(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, *, sim: T.SimConfig = T.SimConfig(),
                   views: ViewConfig = ViewConfig(size=224), batch: int = 64, seed: int = 0, costs=LOCKED_COSTS,
                   out: str | os.PathLike | None = None, save_images: int = 0, progress: bool = False) -> LoopResult:
@@ -639,7 +695,9 @@ def run_llm_agent(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, *, sim: T.Sim
         es: the episodes.
         agent: the MLLM agent (:mod:`ignjax.agents.llm.agent`).
         llm: endpoints, model and request settings (cache in ``llm.cache_dir``).
-        sim: simulator settings (``n_views`` is the panel's view count).
+        sim: simulator settings (``n_views`` is the panel's view count); an
+            agent's ``sim_overrides`` (e.g. ``tandem-4v``'s view count) replace
+            the settings they name.
         views: image settings (default 224 px views: a 672 px panel).
         batch: episodes in flight at once (slots).
         seed: seed of the episodes' keys (as :func:`ignjax.evaluate.runner.run_agent`).
@@ -657,6 +715,9 @@ def run_llm_agent(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, *, sim: T.Sim
     """
     if batch < 1:
         raise ConfigError(None, "batch", f"must be >= 1, got {batch}")
+    overrides = dict(getattr(agent, "sim_overrides", {}) or {})
+    if overrides:  # e.g. the observation ablation's view count, the no-QA variant's upfront description
+        sim = dataclasses.replace(sim, **overrides)
     loop = HostLoop(es, agent, llm, sim=sim, views=views, batch=batch, seed=seed, costs=costs,
                     out=Path(out) if out is not None else None, save_images=save_images, progress=progress)
     return asyncio.run(loop.run())

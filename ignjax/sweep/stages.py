@@ -25,7 +25,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from ignjax.agents import get_agent
-from ignjax.agents.llm.agent import LLM_AGENTS, get_llm_agent
+from ignjax.agents.llm.catalog import LLM_AGENTS, get_llm_agent
 from ignjax.agents.params import plans_with_costs
 from ignjax.config import SweepConfig, digest
 from ignjax.episodes.construct import BuildConfig, build_benchmark

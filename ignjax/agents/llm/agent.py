@@ -280,16 +280,5 @@ class VlmAgent(LLMAgent):
                            schema=decision_schema(d.n_views), tag=d.episode)
 
 
-LLM_AGENTS = {"vlm": VlmAgent}
-"""Registry of MLLM agents by name (built by the host loop with keyword options)."""
-
-
-def get_llm_agent(name: str, **options) -> LLMAgent:
-    """The MLLM agent ``name`` (:data:`LLM_AGENTS`) with its options."""
-    if name not in LLM_AGENTS:
-        raise KeyError(name)
-    return LLM_AGENTS[name](**options)
-
-
-__all__ = ["ASK", "Decision", "EpisodeMemory", "LLMAgent", "LLM_AGENTS", "MOVE", "QUESTION_NAMES", "STOP", "VlmAgent",
-           "decision_schema", "get_llm_agent"]
+__all__ = ["ASK", "Decision", "EpisodeMemory", "LLMAgent", "MOVE", "QUESTION_NAMES", "STOP", "VlmAgent",
+           "decision_schema"]

@@ -1,0 +1,577 @@
+"""TANDEM, the paper's two-stage MLLM navigator, its ablations and the
+baselines of Table 1 as configurations of one machinery.
+
+One decision of :class:`Tandem`:
+
+1. **Controller first** (host code, no model call) when a safeguard settles
+   the decision: after a "yes" to a confirmation question with the follow-up
+   "stop now", STOP; the recovery rule (several moves without any route hint
+   and without a confirmed candidate, questions left) asks a route question
+   (Type 3).
+2. **Planner** (one request): the instruction, the N-view panel (or, for the
+   text-only baseline, each view described from the simulator's perception),
+   the Fact Base (the oracle's answers, by type), the active route hint and
+   its progress, the follow-up state, the Spatial Memory (current place,
+   target facts, visited areas, unexplored openings, route hints, blocked
+   moves, candidate status), recent movement history, the steps and
+   questions left and, in the cost-aware setting, each question's cost. It
+   replies with one JSON decision (:func:`planner_schema`): ask (type and
+   question), move (direction, a place-based subgoal, purpose) or stop
+   (with its evidence), plus a belief update that the controller merges into
+   Spatial Memory.
+3. **Controller checks** on the Planner's decision; a decision that breaks
+   a rule is answered with a correction and asked again (counted as an
+   invalid reply, like a malformed one): a Type-1/2 question whose fact is
+   already in the Fact Base (safeguard 1); a route question where none of
+   its triggers holds — a branch (three or more open directions), a loop
+   (back within a metre of an earlier position), a long corridor, or the
+   goal room known while the agent is elsewhere (safeguard 2); any question,
+   or a move that is not toward the front half, while the follow-up asks
+   for "one closer move" (safeguard 3); a second backward move in a row
+   when the last was not blocked (anti-oscillation). A STOP without
+   evidence (no confirmed target, no hint saying the target is near) is
+   turned into a confirmation question when questions are left (the stop
+   policy: confirm before stopping).
+4. **Grounder** (one request, MOVE only): the selected view alone with its
+   numbered 8x8 grid, the subgoal and the purpose; the reply is one cell
+   (columns left to right, rows bottom to top; rows 1-3 for floor targets),
+   which the executor turns into a waypoint. An unusable Grounder reply
+   falls back to the centre cell of row 2.
+
+The prompts are ours, written to the paper's structure (role and
+observation; memory and interaction; question, hint and recovery policies;
+output contract; runtime state). Everything numeric the controller reads
+(free space per sector, odometry for loops, room codes) comes from
+:attr:`~ignjax.agents.llm.agent.Decision.percept` and never reaches the
+model as a number.
+
+Variants (:data:`TANDEM_AGENTS`, README "MLLM agents"): ``tandem``;
+``tandem-no-spmem`` (no Spatial Memory: belief updates dropped, the memory
+block not shown); ``tandem-no-qa`` (never asks; the target's full
+description given at reset, as the paper's QA-off row); ``tandem-no-spmem-no-qa``;
+``tandem-naive`` (no costs shown, no safeguards: the naive-QA protocol);
+``tandem-4v`` / ``tandem-12v`` (the observation ablation: 4 or 12 views).
+Baselines in the style of the paper's adaptations (our reading of each, on
+this machinery; the paper's own code is not used): ``gta``
+(Planner-Grounder without Spatial Memory), ``coin`` (no route questions),
+``mapgpt`` (one stage: the Planner picks the grid cell itself, with a
+map-like text memory of places and their links), ``navgpt`` (one stage,
+text only: each view described from the simulator's perception, stated as
+such in the prompt); each in a cost-aware form (costs shown, safeguards on)
+and a naive-QA form (``-naive``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from ignjax.agents.llm.agent import ASK, MOVE, QUESTION_HELP, QUESTION_NAMES, STOP, Decision, LLMAgent
+from ignjax.agents.llm.client import ChatRequest
+from ignjax.sim import types as T
+from ignjax.sim.views.compose import view_names
+
+PHASES = ("explore", "verify", "approach", "recover")
+OPEN_M = 1.5
+"""A sector counts as an open direction when its free floor reaches this far (m)."""
+LOOP_M = 1.0
+"""Back within this distance of a position of two or more decisions ago: a loop (m)."""
+CORRIDOR_M = 3.0
+"""Long corridor: front and rear open past this, both sides closed (m)."""
+RECOVERY_MOVES = 5
+"""Moves without a route hint and without a confirmed candidate before the recovery rule asks one."""
+MEMORY_ITEMS = 6
+"""Entries kept per Spatial Memory list."""
+TEXT_CHARS = 160
+"""Longest text kept from one belief-update entry."""
+GROUNDER_FALLBACK = (4, 2)
+"""Cell taken when no Grounder reply is usable: centre column, near floor."""
+
+
+def planner_schema(names: tuple[str, ...], actions=("move", "ask", "stop"), questions=(1, 2, 3, 4)) -> dict:
+    """JSON schema of one Planner decision (every key required; the ones an
+    action does not use are ignored): ``actions`` the agent may take,
+    ``questions`` the types it may ask."""
+    s = {"type": "string", "maxLength": TEXT_CHARS}
+    lst = {"type": "array", "items": s, "maxItems": MEMORY_ITEMS}
+    return {
+        "type": "object",
+        "properties": {
+            "reasoning": {"type": "string", "maxLength": 400},
+            "task_phase": {"type": "string", "enum": list(PHASES)},
+            "belief_update": {
+                "type": "object",
+                "properties": {"current_room": s, "target_description": s, "visited_areas": lst,
+                               "unexplored_areas": lst, "key_observations": lst},
+                "required": ["current_room", "target_description", "visited_areas", "unexplored_areas",
+                             "key_observations"],
+                "additionalProperties": False,
+            },
+            "action": {"type": "string", "enum": list(actions)},
+            "direction": {"type": "string", "enum": list(names)},
+            "subgoal": s,
+            "purpose": s,
+            "question_type": {"type": "integer", "enum": list(questions)},
+            "question": s,
+        },
+        "required": ["reasoning", "task_phase", "belief_update", "action", "direction", "subgoal", "purpose",
+                     "question_type", "question"],
+        "additionalProperties": False,
+    }
+
+
+def one_stage_schema(names: tuple[str, ...], actions=("move", "ask", "stop"), questions=(1, 2, 3, 4)) -> dict:
+    """The Planner schema plus the grid cell (one-stage baselines pick it themselves)."""
+    s = planner_schema(names, actions, questions)
+    s["properties"].update({"col": {"type": "integer", "minimum": 1, "maximum": 8},
+                            "row": {"type": "integer", "minimum": 1, "maximum": 8}})
+    s["required"] = s["required"] + ["col", "row"]
+    return s
+
+
+GROUNDER_SCHEMA = {
+    "type": "object",
+    "properties": {"col": {"type": "integer", "minimum": 1, "maximum": 8},
+                   "row": {"type": "integer", "minimum": 1, "maximum": 8},
+                   "rationale": {"type": "string", "maxLength": 200}},
+    "required": ["col", "row", "rationale"],
+    "additionalProperties": False,
+}
+
+
+@dataclass
+class TandemMemory:
+    """One episode's host-side state: Spatial Memory, Fact Base, history."""
+
+    current_room: str = "unknown"
+    target_description: str = "unknown"
+    visited: list = field(default_factory=list)
+    unexplored: list = field(default_factory=list)
+    observations: list = field(default_factory=list)
+    places: list = field(default_factory=list)  # map-like memory (mapgpt): "step k: place"
+    moves: list = field(default_factory=list)  # (step, direction name, subgoal, rear-family, outcome)
+    history: list = field(default_factory=list)  # (step, kind, action, reason): LLMAgent's record
+    positions: list = field(default_factory=list)  # odometry (x, y) per decision
+    last_purpose: str = ""
+    questions: list = field(default_factory=list)  # (step, type, question text)
+    candidates: list = field(default_factory=list)  # Type-4 outcomes in words
+    moves_since_hint: int = 0
+
+
+def _clip(text, n: int = TEXT_CHARS) -> str:
+    return " ".join(str(text or "").split())[:n]
+
+
+def _rear(k: int, n: int) -> bool:
+    a = (360.0 * k / n) % 360.0
+    return 90.0 < a < 270.0
+
+
+class Tandem(LLMAgent):
+    """TANDEM and its variants (module docstring).
+
+    Args:
+        spatial_memory: keep and show Spatial Memory (belief updates merged).
+        qa: the agent may ask questions (False: the target's full description
+            is given at reset, ``sim.upfront_description``).
+        cost_aware: the prompt shows each question type's cost.
+        safeguards: the controller's four safeguards, anti-oscillation and the
+            stop policy (False: the naive protocol, every decision the model's).
+        two_stage: a Grounder picks the cell (False: the Planner picks it).
+        route_questions: Type 3 may be asked (False: COIN-style).
+        memory_style: ``"spatial"`` (the paper's fields) or ``"map"``
+            (MapGPT-style: places visited and how they connect).
+        observation: ``"panel"`` or ``"text"`` (NavGPT-style captions from
+            the simulator's perception).
+        n_views: views of the panel (4, 8 or 12; the observation ablation).
+        reasks: corrections before the default action.
+    """
+
+    name = "tandem"
+    description = "TANDEM: Planner + Grounder, Spatial Memory, Fact Base, cost-aware typed questions, safeguards"
+    uses_views = True
+
+    def __init__(self, spatial_memory: bool = True, qa: bool = True, cost_aware: bool = True, safeguards: bool = True,
+                 two_stage: bool = True, route_questions: bool = True, memory_style: str = "spatial",
+                 observation: str = "panel", n_views: int | None = None, reasks: int = 2):
+        if observation not in ("panel", "text"):
+            raise ValueError(f"observation must be 'panel' or 'text', got {observation!r}")
+        if memory_style not in ("spatial", "map"):
+            raise ValueError(f"memory_style must be 'spatial' or 'map', got {memory_style!r}")
+        if n_views not in (None, 4, 8, 12):
+            raise ValueError(f"n_views must be 4, 8 or 12, got {n_views!r}")
+        self.spatial_memory, self.qa, self.show_costs = bool(spatial_memory), bool(qa), bool(cost_aware)
+        self.safeguards, self.two_stage, self.route_questions = bool(safeguards), bool(two_stage), bool(route_questions)
+        self.memory_style, self.observation, self.n_views, self.reasks = memory_style, observation, n_views, int(reasks)
+        self.may_ask = self.qa
+        self.uses_views = self.two_stage and observation == "panel"
+
+    @property
+    def sim_overrides(self) -> dict:
+        """Simulator settings this agent runs under (applied by the host loop)."""
+        out = {}
+        if not self.qa:
+            out["upfront_description"] = True
+        if self.n_views is not None:
+            out["n_views"] = self.n_views
+        return out
+
+    def start(self, episode: str) -> TandemMemory:
+        return TandemMemory()
+
+    # -- controller --------------------------------------------------------
+    def _route_triggers(self, m: TandemMemory, d: Decision) -> list[str]:
+        p = d.percept
+        opened = [float(x) >= OPEN_M for x in p.get("open", [])]
+        out = []
+        if sum(opened) >= 3:
+            out.append("branch")
+        pos = p.get("odometry")
+        if pos is not None and any(math.dist(pos, q) < LOOP_M for q in m.positions[:-2]):
+            out.append("loop")
+        free = p.get("open", [])
+        if len(free) == 8 and min(free[0], free[4]) >= CORRIDOR_M and max(free[2], free[6]) < OPEN_M:
+            out.append("corridor")
+        if p.get("goal_room", -1) >= 0 and p.get("room", -1) != p.get("goal_room"):
+            out.append("goal room elsewhere")
+        return out
+
+    def _controller(self, m: TandemMemory, d: Decision):
+        """An action the controller takes without asking the model, or None."""
+        p = d.percept
+        if not self.safeguards:
+            return None
+        if p.get("follow_up") == T.FOLLOW_STOP_NOW and p.get("confirm") == 1:
+            return (STOP, 0, 4, 1, 1)
+        if (self.qa and self.route_questions and d.questions_left > 0 and m.moves_since_hint >= RECOVERY_MOVES
+                and not p.get("hint_active") and p.get("confirm") != 1):
+            m.moves_since_hint = 0
+            return (ASK, 0, 4, 1, 3)
+        return None
+
+    def _check(self, m: TandemMemory, d: Decision, parsed: dict):
+        """``(action, None)`` or ``(None, why)`` for a Planner decision (module docstring, step 3)."""
+        names = view_names(d.n_views)
+        a = parsed.get("action")
+        p = d.percept
+        known = p.get("known", [False] * 4)
+        follow = p.get("follow_up") == T.FOLLOW_ONE_MOVE and p.get("confirm") == 1
+        if a == "ask":
+            t = parsed.get("question_type")
+            if not self.may_ask:
+                return None, "questions are not available to you; choose move or stop"
+            if not isinstance(t, int) or isinstance(t, bool) or not 1 <= t <= 4:
+                return None, "field 'question_type' must be an integer from 1 to 4"
+            if t == 3 and not self.route_questions:
+                return None, "route questions (type 3) are not available to you; ask another type or move"
+            if d.questions_left <= 0:
+                return None, "no questions are left; choose move or stop"
+            if self.safeguards:
+                if follow:
+                    return None, "the target is confirmed; make one closer move toward it, then stop"
+                if t in (1, 2) and known[t - 1]:
+                    return None, (f"the {QUESTION_NAMES[t]} fact is already in the Fact Base; use it instead of "
+                                  "asking again")
+                if t == 3 and not self._route_triggers(m, d):
+                    return None, ("a route question helps at a branch, after a loop, in a long corridor or when the "
+                                  "goal room is known but you are not in it; none applies here, so move or ask "
+                                  "another type")
+            return (ASK, 0, 4, 1, t), None
+        if a == "stop":
+            evidence = (p.get("confirm") == 1 or p.get("hint_progress") == T.HINT_STOP)
+            if self.safeguards and not evidence and self.may_ask and d.questions_left > 0 and not known[3]:
+                return (ASK, 0, 4, 1, 4), None  # confirm before stopping
+            return (STOP, 0, 4, 1, 1), None
+        if a == "move":
+            name = parsed.get("direction")
+            if name not in names:
+                return None, f"field 'direction' must be one of {', '.join(names)}"
+            k = names.index(name)
+            if not _clip(parsed.get("subgoal")):
+                return None, "a move needs a subgoal naming a place in that view"
+            if self.safeguards:
+                if follow and _rear(k, d.n_views):
+                    return None, "the target is confirmed ahead of you; move one step closer toward it, not backward"
+                last = m.moves[-1] if m.moves else None
+                if (_rear(k, d.n_views) and last is not None and last[3] and last[4] != "blocked"
+                        and not follow):
+                    return None, ("your last move already went backward; choose a front or side direction, or ask a "
+                                  "route question if you are unsure")
+            return (MOVE, k, 0, 0, 1), None
+        return None, "field 'action' must be one of move, ask, stop"
+
+    # -- prompts -----------------------------------------------------------
+    def planner_system(self, d: Decision) -> str:
+        names = view_names(d.n_views)
+        qtypes = [t for t in (1, 2, 3, 4) if self.route_questions or t != 3]
+        costs = (lambda t: f" (costs {d.costs[t - 1]:.3f})") if self.show_costs else (lambda t: "")
+        see = (f"one image of {d.n_views} camera views around you, each 90 degrees wide and labelled with its "
+               f"direction ({', '.join(names)}), arranged as a map around a centre cell: front is up, left is left"
+               if self.observation == "panel" else
+               f"a written description of what each of your {d.n_views} directions shows ({', '.join(names)}); the "
+               "descriptions come from the simulator's perception, not from a camera")
+        blocks = [
+            # block 1: role, environment, observation
+            "You are the planner of a robot searching a house for one particular object. Several objects of the "
+            "same kind may be there; only one is the target. You decide what to do next and why; a separate module "
+            "turns your choice of direction and place into motion, and obstacle avoidance is handled for you. Stay "
+            f"indoors.\nEach turn you receive {see}.",
+        ]
+        if self.qa:
+            blocks.append(
+                # block 2: memory and interaction
+                ("You keep a memory of the search (given back to you each turn) and update it in 'belief_update': "
+                 "the room you think you are in, what you know about the target, areas you have visited and what "
+                 "was there, openings you have not explored yet, and anything else worth remembering.\n"
+                 if self.spatial_memory else "")
+                + "You may ask a helper who knows the house. Question types:\n"
+                + "\n".join(f"  {t} ({QUESTION_NAMES[t]}): {QUESTION_HELP[t]}{costs(t)}" for t in qtypes)
+                + "\nEvery question lowers the final score" + (" by its cost" if self.show_costs else "")
+                + "; ask only when the answer changes your next decision, and never ask what the Fact Base already "
+                "says.")
+            blocks.append(
+                # block 3: question, hint and recovery policies
+                "Policies:\n"
+                "- Early on, while the Fact Base lacks the target's appearance or room, asking for them usually pays.\n"
+                + ("- A route question fits a junction with several plausible ways, a loop (you are back where you "
+                   "were), a long corridor, or a known goal room whose way in is unclear. While a route hint is "
+                   "active, use it as your main bias and choose short, reachable places on the hinted side; trust "
+                   "what you see if it contradicts the hint.\n" if self.route_questions else "")
+                + "- Ask for a confirmation when an object in front of you might be the target. After a yes with "
+                "'move closer', make exactly one move toward it and then stop; after a plain yes, stop.\n"
+                "- Stop only when the target is confirmed or a hint says you are close enough to it.\n"
+                "- Avoid going back and forth: backward directions are for recovery (dead end, wrong room); after one "
+                "backward move prefer a new front or side way.")
+        else:
+            blocks.append(
+                ("You keep a memory of the search (given back to you each turn) and update it in 'belief_update'.\n"
+                 if self.spatial_memory else "")
+                + "You cannot ask questions: the target's description is given in the Fact Base. Stop when you are "
+                "next to the target. Avoid going back and forth.")
+        cell = (" and 'col', 'row': the cell of the grid on that view to walk toward (columns 1-8 left to right, "
+                "rows 1-8 bottom to top; rows 1-3 are the floor ahead, higher rows lie further away or on walls)"
+                if not self.two_stage else "")
+        blocks.append(
+            # block 4: output contract
+            "Reply with one JSON object and nothing else, with every key present: 'reasoning' (short), 'task_phase' "
+            f"({' | '.join(PHASES)}), 'belief_update' (current_room, target_description, visited_areas, "
+            "unexplored_areas, key_observations), 'action' (move | ask | stop), 'direction' (one of "
+            f"{', '.join(names)}), 'subgoal' (the place to reach in that view, e.g. 'the centre of the open doorway', "
+            "not an action like 'explore'), 'purpose' (why), 'question_type' (1-4) and 'question' (the question's "
+            f"text){cell}. Keys your action does not use are ignored.")
+        return "\n\n".join(blocks)
+
+    def memory_text(self, m: TandemMemory) -> str:
+        if self.memory_style == "map":
+            return ("Places so far (in order; each reached from the one before):\n"
+                    + ("\n".join(f"- {p}" for p in m.places[-MEMORY_ITEMS * 2:]) or "- (start)"))
+        lines = [f"Current place: {m.current_room}", f"Target facts: {m.target_description}",
+                 "Visited areas: " + ("; ".join(m.visited) or "none yet"),
+                 "Unexplored openings: " + ("; ".join(m.unexplored) or "none noted"),
+                 "Key observations: " + ("; ".join(m.observations) or "none"),
+                 "Blocked or failed moves: " + ("; ".join(f"step {s}: {n}" for s, n, _, _, o in m.moves[-MEMORY_ITEMS:]
+                                                        if o == "blocked") or "none"),
+                 "Candidate status: " + ("; ".join(m.candidates[-3:]) or "no candidate checked")]
+        return "\n".join(lines)
+
+    def state_text(self, m: TandemMemory, d: Decision) -> str:
+        facts = {t: [x for q, x in d.answers if q == t] for t in (1, 2, 3, 4)}
+        fb = []
+        if facts[1]:
+            fb.append(f"- appearance: {facts[1][-1]}")
+        if facts[2]:
+            fb.append(f"- location: {facts[2][-1]}")
+        if facts[4]:
+            fb.append(f"- last confirmation: {facts[4][-1]}")
+        parts = [f"Find the {d.goal}.", "Fact Base:\n" + ("\n".join(fb) or "(empty)")]
+        if m.questions:
+            parts.append("Questions asked: " + "; ".join(f"step {s}: type {t}" for s, t, _ in m.questions[-8:]))
+        p = d.percept
+        if p.get("hint_active") and facts[3]:
+            parts.append(f"Active route hint: {facts[3][-1]}" + (f"\nProgress: {d.last_move}" if d.last_move else ""))
+        if p.get("confirm") == 1 and p.get("follow_up") == T.FOLLOW_ONE_MOVE:
+            parts.append("Follow-up: the target is confirmed; make one closer move, then stop.")
+        if self.spatial_memory:
+            parts.append("Spatial Memory:\n" + self.memory_text(m))
+            if m.last_purpose:
+                parts.append(f"Last purpose: {m.last_purpose}")
+        hist = [f"step {s}: {n}" + (f" toward {g}" if g else "") + (f" ({o})" if o else "") for s, n, g, _, o in m.moves[-6:]]
+        parts.append("Movement history: " + ("; ".join(hist) or "none yet"))
+        if d.last_move and not (p.get("hint_active") and facts[3]):
+            parts.append(f"Last move: {d.last_move}")
+        parts.append(f"Turn {d.step + 1} of at most {d.max_steps}; questions left: {d.questions_left if self.qa else 0}.")
+        parts.append(f"What you see:\n{d.observation}" if self.observation == "text" else "Your views follow.")
+        return "\n\n".join(parts)
+
+    def planner_request(self, m: TandemMemory, d: Decision) -> ChatRequest:
+        names = view_names(d.n_views)
+        content: list = [self.state_text(m, d)]
+        if self.observation == "panel":
+            if d.panel is None:
+                raise ValueError(f"the {self.name} agent reads the panel, but the decision carries none")
+            content.append(d.panel)
+        actions = ("move", "ask", "stop") if self.may_ask else ("move", "stop")
+        questions = (1, 2, 3, 4) if self.route_questions else (1, 2, 4)
+        schema = (planner_schema if self.two_stage else one_stage_schema)(names, actions, questions)
+        return ChatRequest(messages=[{"role": "system", "content": self.planner_system(d)},
+                                     {"role": "user", "content": content}],
+                           schema=schema, schema_name="planner_decision", tag=d.episode)
+
+    def grounder_request(self, d: Decision, image, subgoal: str, purpose: str) -> ChatRequest:
+        system = ("You ground a navigation instruction in one camera view covered by a numbered 8x8 grid. Columns 1-8 "
+                  "run left to right (4 and 5 are the centre); rows 1-8 run from the bottom edge up: row 1 is the floor "
+                  "just ahead, rows 1-2 are near floor targets, row 3 is for farther targets such as a doorway or the "
+                  "end of a corridor, rows 4-8 usually hit walls, furniture tops or the ceiling. First find the place "
+                  "the instruction names in the image, then pick the cell on the floor at it; for a doorway or passage "
+                  "pick its centre, not its edge; use row 3 only when the way there is clearly open, else row 2. "
+                  'Reply with one JSON object: {"col": 1-8, "row": 1-8, "rationale": "<a few words>"}.')
+        text = f"Navigation instruction: {subgoal}" + (f"\nPurpose: {purpose}" if purpose else "") + "\nCurrent view:"
+        return ChatRequest(messages=[{"role": "system", "content": system}, {"role": "user", "content": [text, image]}],
+                           schema=GROUNDER_SCHEMA, schema_name="grounder_cell", tag=d.episode)
+
+    # -- memory updates ------------------------------------------------------
+    def _merge(self, m: TandemMemory, d: Decision, parsed: dict) -> None:
+        m.last_purpose = _clip(parsed.get("purpose"))
+        if self.memory_style == "map":
+            b = parsed.get("belief_update") or {}
+            place = _clip(b.get("current_room") if isinstance(b, dict) else "", 80)
+            if place:
+                m.places.append(f"step {d.step}: {place}")
+            return
+        if not self.spatial_memory:
+            return
+        b = parsed.get("belief_update")
+        if not isinstance(b, dict):
+            return
+        if _clip(b.get("current_room")):
+            m.current_room = _clip(b.get("current_room"))
+        if _clip(b.get("target_description")):
+            m.target_description = _clip(b.get("target_description"))
+
+        def items(key):
+            v = b.get(key)
+            return [_clip(x) for x in v if _clip(x)] if isinstance(v, list) else []
+
+        m.visited = list(dict.fromkeys(m.visited + items("visited_areas")))[-MEMORY_ITEMS:]
+        m.unexplored = items("unexplored_areas")[-MEMORY_ITEMS:] or m.unexplored
+        m.observations = (m.observations + items("key_observations"))[-MEMORY_ITEMS:]
+
+    def _observe_outcome(self, m: TandemMemory, d: Decision) -> None:
+        """Fold the last step's outcome (executor feedback, answers) into memory."""
+        p = d.percept
+        if m.moves and m.moves[-1][4] == "" and m.history and m.history[-1][1] == "move":
+            moved_blocked = "blocked" if "did not move" in d.last_move else "moved"
+            s, n, g, r, _ = m.moves[-1]
+            m.moves[-1] = (s, n, g, r, moved_blocked)
+        if m.questions and m.questions[-1][1] == 4 and m.questions[-1][0] == d.step - 1:
+            m.candidates.append(f"step {d.step - 1}: " + ("confirmed" if p.get("confirm") == 1 else "rejected"))
+        m.positions.append(tuple(p.get("odometry", (0.0, 0.0))))
+
+    # -- one decision ------------------------------------------------------
+    async def decide(self, ctx, m: TandemMemory, d: Decision):
+        self._observe_outcome(m, d)
+        act = self._controller(m, d)
+        if act is None:
+            plan = await ctx.query(self.planner_request(m, d), lambda parsed, err: self._parse_plan(m, d, parsed, err))
+            if plan is None:
+                act = ctx.default(self.default_action(m, d))
+                m.history.append((d.step, "move", act, "(default after invalid replies)"))
+            else:
+                act, parsed = plan
+                self._merge(m, d, parsed)
+                if act[0] == MOVE:
+                    act = await self._ground(ctx, m, d, act, parsed)
+        self._record(m, d, act)
+        return act
+
+    def _parse_plan(self, m: TandemMemory, d: Decision, parsed, err):
+        if parsed is None:
+            return None, err or "the reply is not a JSON object"
+        act, why = self._check(m, d, parsed)
+        if act is None:
+            return None, why
+        if act[0] == MOVE and not self.two_stage:
+            for key in ("col", "row"):
+                v = parsed.get(key)
+                if isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= 8:
+                    return None, f"field '{key}' must be an integer from 1 to 8"
+            act = (MOVE, act[1], parsed["col"], parsed["row"], 1)
+        return (act, parsed), None
+
+    async def _ground(self, ctx, m: TandemMemory, d: Decision, act, parsed):
+        if not self.two_stage:
+            return act
+        k = act[1]
+        req = self.grounder_request(d, ctx.view_image(k), _clip(parsed.get("subgoal")), _clip(parsed.get("purpose")))
+
+        def cell(p, err):
+            if p is None:
+                return None, err or "the reply is not a JSON object"
+            for key in ("col", "row"):
+                v = p.get(key)
+                if isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= 8:
+                    return None, f"field '{key}' must be an integer from 1 to 8"
+            return (p["col"], p["row"]), None
+
+        got = await ctx.query(req, cell, role="grounder")
+        col, row = got if got is not None else GROUNDER_FALLBACK
+        return (MOVE, k, col, row, 1)
+
+    def _record(self, m: TandemMemory, d: Decision, act) -> None:
+        names = view_names(d.n_views)
+        kind = {MOVE: "move", ASK: "ask", STOP: "stop"}[act[0]]
+        if not m.history or m.history[-1][0] != d.step:
+            m.history.append((d.step, kind, act, ""))
+        if act[0] == MOVE:
+            m.moves.append((d.step, names[act[1]], m.last_purpose and _clip(m.last_purpose, 60), _rear(act[1], d.n_views), ""))
+            m.moves_since_hint = 0 if d.percept.get("hint_active") else m.moves_since_hint + 1
+        elif act[0] == ASK:
+            m.questions.append((d.step, act[4], ""))
+            if act[4] == 3:
+                m.moves_since_hint = 0
+
+    def default_action(self, memory, d: Decision):
+        """After unusable Planner replies: a short move toward the front view's centre."""
+        return (MOVE, 0, 4, 2, 1)
+
+
+def _variant(name: str, description: str, **options):
+    def make(**overrides):
+        agent = Tandem(**{**options, **overrides})
+        agent.name, agent.description = name, description
+        return agent
+
+    make.description = description
+    return make
+
+
+TANDEM_AGENTS = {
+    "tandem": _variant("tandem", "TANDEM: Planner + Grounder, Spatial Memory, Fact Base, cost-aware questions, "
+                                 "safeguards"),
+    "tandem-no-spmem": _variant("tandem-no-spmem", "TANDEM without Spatial Memory", spatial_memory=False),
+    "tandem-no-qa": _variant("tandem-no-qa", "TANDEM without questions (description given at reset)", qa=False),
+    "tandem-no-spmem-no-qa": _variant("tandem-no-spmem-no-qa", "TANDEM without Spatial Memory and questions",
+                                      spatial_memory=False, qa=False),
+    "tandem-naive": _variant("tandem-naive", "TANDEM, naive-QA protocol (no costs shown, no safeguards)",
+                             cost_aware=False, safeguards=False),
+    "tandem-4v": _variant("tandem-4v", "TANDEM with 4 views (observation ablation)", n_views=4),
+    "tandem-12v": _variant("tandem-12v", "TANDEM with 12 views (observation ablation)", n_views=12),
+    "gta": _variant("gta", "GTA-style: Planner + Grounder without Spatial Memory, cost-aware", spatial_memory=False),
+    "gta-naive": _variant("gta-naive", "GTA-style, naive-QA", spatial_memory=False, cost_aware=False,
+                          safeguards=False),
+    "coin": _variant("coin", "COIN-style: no route questions, cost-aware", route_questions=False),
+    "coin-naive": _variant("coin-naive", "COIN-style, naive-QA", route_questions=False, cost_aware=False,
+                           safeguards=False),
+    "mapgpt": _variant("mapgpt", "MapGPT-style: one stage, map-like text memory, cost-aware", two_stage=False,
+                       memory_style="map"),
+    "mapgpt-naive": _variant("mapgpt-naive", "MapGPT-style, naive-QA", two_stage=False, memory_style="map",
+                             cost_aware=False, safeguards=False),
+    "navgpt": _variant("navgpt", "NavGPT-style: one stage, text-only views from the simulator's perception, "
+                                 "cost-aware", two_stage=False, observation="text"),
+    "navgpt-naive": _variant("navgpt-naive", "NavGPT-style, naive-QA", two_stage=False, observation="text",
+                             cost_aware=False, safeguards=False),
+}
+"""The MLLM agents of Table 1 and the ablations, by name (module docstring)."""
+
+
+__all__ = ["GROUNDER_SCHEMA", "TANDEM_AGENTS", "Tandem", "TandemMemory", "one_stage_schema", "planner_schema"]
