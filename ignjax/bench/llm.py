@@ -27,16 +27,52 @@ loops' programs are compiled before anything is timed.
 ``limited_by`` names what bounds the batched figure: the server's
 concurrency x latency, or the host (rendering and stepping) when its
 decisions per second stay below what the server could answer.
+
+``vllm``: the same loop (the ``vlm`` agent, the same views) against a real
+model server: the tiny Qwen2-VL-style model under vLLM's CPU build
+(:mod:`ignjax.agents.llm.vllm_server`, ``--max-num-seqs 8``, vLLM's own
+continuous batching), started for the measurement on this machine. The
+weights are random, so the decisions are arbitrary but schema-valid
+(structured output, temperature 0, no response cache): the figure is
+decisions per second, not quality. It runs on the first episodes of the
+file (loaded on their own, so the simulator's world holds only their
+scenes), ``VLLM_MAX_STEPS`` decisions at most each (fewer where the model
+stops): ``batched`` keeps 8 episodes and 8 requests in flight (refilled from
+``episodes.batched`` episodes), ``sequential`` runs one episode and one
+request at a time. ``decisions_per_s`` is simulator steps taken over the
+loop's wall time (``wall_s``: from its first reset to its last outcome; the
+world's construction before it is not counted); re-asked replies cost
+requests, not decisions. ``request_s``: mean seconds a request waited on the
+server. The loop's programs are compiled (against the scripted server, while
+vLLM starts) and the server warmed up on another episode before anything is
+timed. Views are rendered in the loop's own process (``workers`` 1; the
+same images): each run builds its renderer anew (its first renders of each
+batch size build rendering contexts, in the timed wall), and render worker
+processes would add their start and stop to every run. The server shares
+the machine's cores with the loop's rendering and stepping, so on a small
+CPU machine both figures include that contention.
+Where the environment that ``.ci/prepare-vllm`` builds is absent the block is
+``{"skipped": reason}``; a server that fails to start gives ``{"failed":
+reason}`` (its log's tail on stderr).
 """
 
 from __future__ import annotations
 
+import contextlib
 import re
 import time
+from concurrent.futures import ThreadPoolExecutor, wait
 
 from ignjax.bench.timing import log
 
 DECISIONS = 6
+VLLM_MAX_NUM_SEQS = 8
+VLLM_MAX_STEPS = 4
+"""Decision budget of an episode against vLLM (episodes end there unless the model stops first)."""
+VLLM_BATCH = 8
+"""Episodes (and requests) in flight in the batched run against vLLM."""
+VLLM_MAX_TOKENS = 256
+"""Completion limit: above the longest schema-valid reply (a 200-character reason), so replies are not cut short."""
 
 
 def _policy(req: dict) -> str:
@@ -55,13 +91,13 @@ def _policy(req: dict) -> str:
     return json.dumps(d)
 
 
-def _run(es, srv, batch: int, concurrency: int, views, sim, cache_dir):
+def _run(es, srv, batch: int, concurrency: int, views, sim, cache_dir, **llm_options):
     from ignjax.agents.llm.agent import VlmAgent
     from ignjax.agents.llm.config import LLMConfig
     from ignjax.evaluate.hostloop import run_llm_agent
 
     llm = LLMConfig(endpoints=(srv.base_url,), model=srv.model, api_key_env=None, concurrency=concurrency,
-                    cache_dir=cache_dir, timeout_s=120.0)
+                    cache_dir=cache_dir, **{"timeout_s": 120.0, **llm_options})
     t0 = time.perf_counter()
     res = run_llm_agent(es, VlmAgent(), llm, sim=sim, views=views, batch=batch)
     return res, time.perf_counter() - t0
@@ -90,7 +126,7 @@ def bench_llm(es, quick: bool, latency: float = 4.0, concurrency: int = 64) -> d
     log(f"  host {out['host_ms_per_decision']:.1f} ms a decision ({res.stats['decisions']} decisions, zero latency)")
     with ScriptedServer(latency=latency, jitter=0.25, concurrency=concurrency, policy=_policy) as srv:
         res_b, wall_b = _run(batched_es, srv, concurrency, concurrency, views, sim, None)
-        res_s, wall_s = _run(es.subset(range(n_seq)), srv, 1, 1, views, sim, None)
+        _, wall_s = _run(es.subset(range(n_seq)), srv, 1, 1, views, sim, None)
     eph_b = 3600.0 * len(batched_es) / wall_b
     eph_s = 3600.0 * n_seq / wall_s
     out["episodes_per_hour"] = {"batched": eph_b, "sequential": eph_s}
@@ -104,7 +140,90 @@ def bench_llm(es, quick: bool, latency: float = 4.0, concurrency: int = 64) -> d
     log(f"  batched {eph_b:.0f} episodes/h, sequential {eph_s:.0f}: {out['speedup_vs_sequential']:.1f}x; "
         f"utilisation {out['utilisation']:.2f}; host {host_rate:.1f} decisions/s vs server {server_rate:.1f}/s "
         f"-> limited by the {out['limited_by']}")
+    out["vllm"] = bench_vllm(es, quick, views)
     return out
 
 
-__all__ = ["bench_llm"]
+def bench_vllm(es, quick: bool, views) -> dict:
+    """The ``llm`` block's ``vllm`` figures (module docstring): decisions/s of
+    the host loop against the tiny model's vLLM server, batched and sequential.
+
+    Runs on the first episodes of ``es``'s file (loaded again on their own,
+    so the simulator's world holds only their scenes)."""
+    from ignjax.agents.llm.serve import ScriptedServer
+    from ignjax.agents.llm.vllm_server import (
+        VllmServerError,
+        environment_problem,
+        start_vllm_server,
+        vllm_home,
+    )
+    from ignjax.episodes.dataset import load_benchmark
+    from ignjax.sim.types import SimConfig
+
+    home = vllm_home()
+    problem = environment_problem(home)
+    if problem:
+        reason = f"vLLM server environment not prepared: run .ci/prepare-vllm ({problem})"
+        log(f"  vLLM: skipped ({reason})")
+        return {"skipped": reason}
+    n_b = 2 * VLLM_BATCH if quick else 4 * VLLM_BATCH
+    n_s = 2 if quick else 4
+    n = max(1 + n_b + n_s, VLLM_BATCH)
+    if len(es) < n:
+        raise ValueError(f"the vLLM figures need {n} episodes, {es.path} has {len(es)}")
+    small = load_benchmark(es.path, limit=n)
+    warm_es = small.subset(range(1))
+    batched_es = small.subset(range(1, 1 + n_b))
+    seq_es = small.subset(range(1 + n_b, 1 + n_b + n_s))
+    sim = SimConfig(max_steps=VLLM_MAX_STEPS)
+    # the same images, rendered in the loop's own process: every run builds its renderer anew, and render
+    # worker processes would add their start-up and shut-down (seconds each) to every run's wall time
+    views = views.replace(workers=1)
+    opts = {"temperature": 0.0, "structured": "json_schema", "max_tokens": VLLM_MAX_TOKENS, "timeout_s": 300.0}
+    out = {"max_num_seqs": VLLM_MAX_NUM_SEQS, "in_flight": {"batched": VLLM_BATCH, "sequential": 1},
+           "max_steps": sim.max_steps, "max_tokens": VLLM_MAX_TOKENS, "render_workers": views.workers,
+           "episodes": {"batched": n_b, "sequential": n_s}}
+    log(f"  the same loop against the tiny model's vLLM server (max-num-seqs {VLLM_MAX_NUM_SEQS}, random weights) ...")
+    try:
+        with contextlib.ExitStack() as stack, ThreadPoolExecutor(1) as pool:
+            t0 = time.perf_counter()
+
+            def start():
+                srv = stack.enter_context(start_vllm_server(home, max_num_seqs=VLLM_MAX_NUM_SEQS))
+                return srv, time.perf_counter() - t0
+
+            starting = pool.submit(start)  # the server starts while the loop's programs compile
+            try:
+                with ScriptedServer(latency=0.0, concurrency=VLLM_BATCH, policy=_policy) as scripted:
+                    _run(small.subset(range(VLLM_BATCH)), scripted, VLLM_BATCH, VLLM_BATCH, views, sim, None)
+                    _run(warm_es, scripted, 1, 1, views, sim, None)
+            except BaseException:
+                wait([starting])  # then the stack stops the server
+                raise
+            server, out["server_start_s"] = starting.result()
+            _run(warm_es, server, 1, 1, views, sim, None, **opts)  # warm-up: the server's first requests
+            res_b, _ = _run(batched_es, server, VLLM_BATCH, VLLM_BATCH, views, sim, None, **opts)
+            res_s, _ = _run(seq_es, server, 1, 1, views, sim, None, **opts)
+    except VllmServerError as exc:
+        log(f"  vLLM: {exc}")
+        return {"failed": str(exc).splitlines()[0]}
+    runs = {"batched": res_b, "sequential": res_s}
+    acc = {k: r.accounting for k, r in runs.items()}
+    out["decisions"] = {k: int(r.stats["decisions"]) for k, r in runs.items()}
+    out["requests"] = {k: int(a["requests"].sum()) for k, a in acc.items()}
+    out["invalid_replies"] = {k: int(a["invalid_replies"].sum()) for k, a in acc.items()}
+    out["failed_episodes"] = {k: sum(bool(f) for f in a["failure"]) for k, a in acc.items()}
+    out["request_s"] = {k: float(a["model_latency_s"].sum()) / max(1, out["requests"][k]) for k, a in acc.items()}
+    out["wall_s"] = {k: float(r.stats["wall_s"]) for k, r in runs.items()}
+    out["decisions_per_s"] = {k: out["decisions"][k] / out["wall_s"][k] for k in runs}
+    out["speedup"] = out["decisions_per_s"]["batched"] / out["decisions_per_s"]["sequential"]
+    out["utilisation"] = res_b.stats["utilisation"]
+    d, w = out["decisions_per_s"], out["wall_s"]
+    log(f"  vLLM: batched {d['batched']:.2f} decisions/s ({out['decisions']['batched']} in {w['batched']:.1f} s), "
+        f"sequential {d['sequential']:.2f} ({out['decisions']['sequential']} in {w['sequential']:.1f} s): "
+        f"{out['speedup']:.1f}x; a request {out['request_s']['batched']:.2f} s batched, "
+        f"{out['request_s']['sequential']:.2f} s alone; server start {out['server_start_s']:.0f} s")
+    return out
+
+
+__all__ = ["bench_llm", "bench_vllm"]
