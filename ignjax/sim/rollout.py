@@ -39,12 +39,13 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import weakref
 from functools import partial
 
 import jax
 import jax.numpy as jnp
 import numpy as np
-from jax.sharding import Mesh, PartitionSpec as P
+from jax.sharding import Mesh, NamedSharding, PartitionSpec as P
 
 from ignjax.errors import ConfigError
 from ignjax.sim import env as E
@@ -179,6 +180,26 @@ def _shard_rows(n: int, copies: int, parts: int, widths: tuple[int, int, int]) -
     return -(-m // step) * step
 
 
+_REPLICAS: dict = {}
+
+
+def _replicated(world: World, mesh: Mesh) -> World:
+    """``world`` with a copy on every device of ``mesh``, made once per world
+    and mesh and dropped with the world: the scene bank is large (about half
+    a gigabyte for the shipped benchmark), and copying it to the devices on
+    every call would cost a good part of a batch's time. Each device holds
+    its own copy, CPU devices too."""
+    if mesh.size == 1 or any(isinstance(x, jax.core.Tracer) for x in jax.tree.leaves(world)):
+        return world
+    key = (id(world), mesh)
+    hit = _REPLICAS.get(key)
+    if hit is not None and hit[0]() is world:
+        return hit[1]
+    copy = jax.device_put(world, NamedSharding(mesh, P()))
+    _REPLICAS[key] = (weakref.ref(world, lambda _, k=key: _REPLICAS.pop(k, None)), copy)
+    return copy
+
+
 def _sharded(fn, world, specs, agent, params, keys, chunk, parts: int, copies: int, out_axis: int):
     """``fn(world, specs, agent, params, keys, widths)`` with the episode axis
     of ``specs`` and ``keys`` split over ``parts`` devices, each episode run
@@ -189,7 +210,8 @@ def _sharded(fn, world, specs, agent, params, keys, chunk, parts: int, copies: i
     widths = _widths(n * copies, n, chunk)
     size = _shard_rows(n, copies, parts, widths) * parts
     specs, keys = pad_batch(specs, keys, size)
-    out = _run_sharded(world, specs, params, keys, fn=fn, agent=agent, widths=widths, mesh=device_mesh(parts),
+    mesh = device_mesh(parts)
+    out = _run_sharded(_replicated(world, mesh), specs, params, keys, fn=fn, agent=agent, widths=widths, mesh=mesh,
                        out_axis=out_axis)
     if size == n:
         return out

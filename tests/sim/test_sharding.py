@@ -117,3 +117,26 @@ def test_sweep_on_two_devices_equals_one_device(small_benchmark, small_world, n)
     assert one[0].steps.shape == (K, n) and one[1].kind.shape[:2] == (K, n)
     q = np.asarray(one[0].n_questions).sum(-1)
     assert q[0].sum() > q[1].sum()  # the settings differ, so a swap of the K axis would show
+
+
+@two_devices
+def test_world_is_copied_to_the_devices_once_per_world(small_benchmark):
+    import gc
+
+    from ignjax.sim import rollout as R
+    from ignjax.sim.types import SimConfig
+    from ignjax.sim.world import World
+
+    es = small_benchmark["set"]
+    world = World(es.bank, es.fields, SimConfig())
+    mesh = R.device_mesh(2)
+    copy = R._replicated(world, mesh)
+    assert R._replicated(world, mesh) is copy
+    assert R._replicated(world, R.device_mesh(1)) is world  # one device: the world as it is
+    leaf = jax.tree.leaves(copy)[0]
+    assert len(leaf.sharding.device_set) == 2 and leaf.sharding.is_fully_replicated
+    key = (id(world), mesh)
+    assert key in R._REPLICAS
+    del world, copy, leaf
+    gc.collect()
+    assert key not in R._REPLICAS
