@@ -395,9 +395,7 @@ class SweepConfig:
             except ConfigError as e:
                 raise ConfigError(None, e.where, f"{e.reason}: eval.agents names the MLLM agent {mllm[0]!r}, which "
                                                  "needs a model server (llm.endpoints, llm.model)") from None
-        if self.analysis.agent in LLM_AGENTS:
-            raise ConfigError(None, "analysis.agent", f"the interaction analyses run a JAX-native agent; "
-                                                      f"{self.analysis.agent!r} is an MLLM agent")
+
     def to_dict(self) -> dict[str, dict[str, Any]]:
         """``TOML table -> key -> value`` (lists for tuples): ``run.json``'s ``config``."""
         def plain(items):

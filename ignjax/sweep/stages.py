@@ -178,6 +178,12 @@ def run_sweep(cfg: SweepConfig, studies: list[str], out: Path, *, resume: bool =
     out = Path(out)
     if cfg.derive_costs.annotations and not Path(cfg.derive_costs.annotations).is_file():
         raise InputError(cfg.derive_costs.annotations, "derive-costs.annotations", "file not found")
+    if "analysis" in studies and cfg.analysis.agent in LLM_AGENTS:  # (eval.agents is checked with the config)
+        try:
+            cfg.llm.check_usable()
+        except ConfigError as e:
+            raise ConfigError(None, e.where, f"{e.reason}: analysis.agent is the MLLM agent {cfg.analysis.agent!r}, "
+                                             "which needs a model server (llm.endpoints, llm.model)") from None
     prepare_folder(out, cfg, studies, resume, force)
     needs_rollouts = any(s in studies for s in ("eval", "costs", "difficulty", "analysis"))
     results: dict = {"config": cfg, "studies": studies}

@@ -19,6 +19,7 @@ from ignjax.config import fingerprint, resolve
 from ignjax.errors import ConfigError
 from ignjax.sim.views.config import egl_available, warp_available
 from ignjax.sweep.cli import main
+from ignjax.sweep.stages import run_sweep
 
 ROOT = Path(__file__).resolve().parents[2]
 EPISODES = ROOT / "scenes" / "benchmark.jsonl.gz"
@@ -30,7 +31,8 @@ def _sets(srv, root: Path, cache: Path) -> list[str]:
     return [f"benchmark.episodes='{EPISODES}'", "benchmark.limit=3", f"run.out='{root}'",
             "eval.agents=['random', 'vlm']", "eval.batch=3", "sim.max_steps=6", "views.size=64",
             f"llm.endpoints=['{srv.base_url}']", f"llm.model='{srv.model}'", "llm.api_key_env=''",
-            f"llm.cache_dir='{cache}'", "llm.timeout_s=10.0", "llm.prices={prompt = 0.5, completion = 2.0}"]
+            f"llm.cache_dir='{cache}'", "llm.timeout_s=10.0", "llm.prices={prompt = 0.5, completion = 2.0}",
+            "analysis.agent='vlm'", "analysis.trajectories=1"]
 
 
 def _rows(path: Path) -> list[dict]:
@@ -42,7 +44,7 @@ def _rows(path: Path) -> list[dict]:
 def test_sweep_eval_runs_an_mllm_agent_and_reruns_from_the_cache(tmp_path, capsys):
     with ScriptedServer() as srv:
         sets = _sets(srv, tmp_path, tmp_path / "cache")
-        argv = ["--study", "eval", "--quiet", "--out", str(tmp_path / "a")] + sum((["--set", s] for s in sets), [])
+        argv = ["--study", "eval,analysis", "--quiet", "--out", str(tmp_path / "a")] + sum((["--set", s] for s in sets), [])
         assert main(argv) == 0, capsys.readouterr().err
         sent = srv.stats()["requests"]
         assert sent > 0
@@ -63,8 +65,9 @@ def test_sweep_eval_runs_an_mllm_agent_and_reruns_from_the_cache(tmp_path, capsy
         tokens = [sum(int(r[k]) for r in vlm) for k in ("prompt_tokens", "completion_tokens")]
         cost = (tokens[0] * 0.5 + tokens[1] * 2.0) / 1e6
         assert f"| vlm | {sent} | 0 | {tokens[0]} | {tokens[1]} | 0 | 0 | 0 | {cost:.4f} |" in report
-        # the agent's options are stated in the report header
+        # the agent's options are stated in the report header; the interaction analyses ran on its traces
         assert "- Agent `vlm`: observation=panel" in report
+        assert (tmp_path / "a" / "analysis_per_difficulty.csv").is_file() and "vlm" in report.split("## Interaction")[-1]
 
         # a second run (another folder, same cache) sends nothing and gives the same outcomes
         argv_b = ["--study", "eval", "--quiet", "--out", str(tmp_path / "b")] + sum((["--set", s] for s in sets), [])
@@ -76,7 +79,7 @@ def test_sweep_eval_runs_an_mllm_agent_and_reruns_from_the_cache(tmp_path, capsy
         assert sum(int(r["requests"]) for r in b) == 0
 
 
-def test_mllm_agent_without_a_server_and_other_llm_config_errors():
+def test_mllm_agent_without_a_server_and_other_llm_config_errors(tmp_path):
     with pytest.raises(ConfigError) as e:
         resolve(None, ["eval.agents=['eig', 'vlm']"])
     assert e.value.where == "llm.endpoints" and "'vlm'" in str(e.value)
@@ -88,8 +91,12 @@ def test_mllm_agent_without_a_server_and_other_llm_config_errors():
     assert e.value.where == "llm.timeout_s" and str(e.value).startswith("--set")
     with pytest.raises(ConfigError, match="views.size"):
         resolve(None, ["views.size=20"])
-    with pytest.raises(ConfigError, match="analysis.agent"):
-        resolve(None, ["analysis.agent='vlm'", "llm.endpoints=['http://h/v1']", "llm.model='m'"])
+    # an MLLM agent may be the one analysed; it needs the server only when the analysis study runs
+    cfg = resolve(None, ["analysis.agent='tandem'"])
+    with pytest.raises(ConfigError) as e:
+        run_sweep(cfg, ["analysis"], tmp_path / "never")
+    assert e.value.where == "llm.endpoints" and "analysis.agent" in str(e.value)
+    assert not (tmp_path / "never").exists()
     with pytest.raises(ConfigError, match="unknown key llm.temprature"):
         resolve(None, ["llm.temprature=0.5"])
 
