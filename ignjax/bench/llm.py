@@ -166,6 +166,7 @@ def bench_vllm(es, quick: bool, views) -> dict:
         reason = f"vLLM server environment not prepared: run .ci/prepare-vllm ({problem})"
         log(f"  vLLM: skipped ({reason})")
         return {"skipped": reason}
+    t_part = time.perf_counter()
     n_b = 2 * VLLM_BATCH if quick else 4 * VLLM_BATCH
     n_s = 2 if quick else 4
     n = max(1 + n_b + n_s, VLLM_BATCH)
@@ -222,7 +223,8 @@ def bench_vllm(es, quick: bool, views) -> dict:
     log(f"  vLLM: batched {d['batched']:.2f} decisions/s ({out['decisions']['batched']} in {w['batched']:.1f} s), "
         f"sequential {d['sequential']:.2f} ({out['decisions']['sequential']} in {w['sequential']:.1f} s): "
         f"{out['speedup']:.1f}x; a request {out['request_s']['batched']:.2f} s batched, "
-        f"{out['request_s']['sequential']:.2f} s alone; server start {out['server_start_s']:.0f} s")
+        f"{out['request_s']['sequential']:.2f} s alone; server start {out['server_start_s']:.0f} s, "
+        f"{time.perf_counter() - t_part:.0f} s in all")
     return out
 
 
