@@ -17,6 +17,12 @@ every episode is ``DECISIONS`` decisions long.
   request in flight), on the first episodes only; episodes per hour
   extrapolated from its wall time.
 
+Wall times are the loop's own (``stats["wall_s"]``: first reset to last
+outcome); every run of the block shares one simulator world and one
+renderer, made once (render processes started, rendering contexts built by
+the warm-up), so neither the world's construction nor process start-up is
+in any figure.
+
 ``utilisation`` is the batched run's mean requests in flight divided by the
 concurrency, over the whole run (compilation of the simulator's jitted
 pieces happens before the first request and is not counted in it, but is in
@@ -45,10 +51,8 @@ world's construction before it is not counted); re-asked replies cost
 requests, not decisions. ``request_s``: mean seconds a request waited on the
 server. The loop's programs are compiled (against the scripted server, while
 vLLM starts) and the server warmed up on another episode before anything is
-timed. Views are rendered in the loop's own process (``workers`` 1; the
-same images): each run builds its renderer anew (its first renders of each
-batch size build rendering contexts, in the timed wall), and render worker
-processes would add their start and stop to every run. The server shares
+timed. Every run shares one world and one renderer (render processes and
+contexts made once, before the timed runs). The server shares
 the machine's cores with the loop's rendering and stepping, so on a small
 CPU machine both figures include that contention.
 Where the environment that ``.ci/prepare-vllm`` builds is absent the block is
@@ -91,16 +95,30 @@ def _policy(req: dict) -> str:
     return json.dumps(d)
 
 
-def _run(es, srv, batch: int, concurrency: int, views, sim, cache_dir, **llm_options):
+def _run(es, srv, batch: int, concurrency: int, views, sim, cache_dir, shared=None, **llm_options):
+    """One host-loop run; its wall time is the loop's own (``stats["wall_s"]``: from the first reset to the last
+    outcome), with the world and renderer of ``shared`` (made once, warm) when given."""
     from ignjax.agents.llm.agent import VlmAgent
     from ignjax.agents.llm.config import LLMConfig
     from ignjax.evaluate.hostloop import run_llm_agent
 
     llm = LLMConfig(endpoints=(srv.base_url,), model=srv.model, api_key_env=None, concurrency=concurrency,
                     cache_dir=cache_dir, **{"timeout_s": 120.0, **llm_options})
-    t0 = time.perf_counter()
-    res = run_llm_agent(es, VlmAgent(), llm, sim=sim, views=views, batch=batch)
-    return res, time.perf_counter() - t0
+    res = run_llm_agent(es, VlmAgent(), llm, sim=sim, views=views, batch=batch, **(shared or {}))
+    return res, float(res.stats["wall_s"])
+
+
+@contextlib.contextmanager
+def _shared(es, sim, views):
+    """The world and renderer every run of a figure reuses (render processes and contexts warm across runs)."""
+    from ignjax.evaluate.runner import make_world
+    from ignjax.sim.views import ViewRenderer
+
+    renderer = ViewRenderer(es.bank, sim, views)
+    try:
+        yield {"world": make_world(es, sim), "renderer": renderer}
+    finally:
+        renderer.close()
 
 
 def bench_llm(es, quick: bool, latency: float = 4.0, concurrency: int = 64) -> dict:
@@ -116,17 +134,18 @@ def bench_llm(es, quick: bool, latency: float = 4.0, concurrency: int = 64) -> d
     batched_es = es.subset(range(min(n_batched, len(es))))
     out = {"concurrency": concurrency, "latency_s": latency, "views": sim.n_views, "size": views.size,
            "decisions_per_episode": DECISIONS, "episodes": {"batched": len(batched_es), "sequential": n_seq}}
-    # host cost per decision: zero-latency server, after a warm-up (compilation, render workers)
-    with ScriptedServer(latency=0.0, concurrency=concurrency, policy=_policy) as srv:
-        warm = es.subset(range(min(concurrency, len(es))))
-        _run(warm, srv, concurrency, concurrency, views, sim, None)
-        _run(es.subset(range(1)), srv, 1, 1, views, sim, None)  # the sequential loop's programs, compiled too
-        res, wall = _run(warm, srv, concurrency, concurrency, views, sim, None)
-    out["host_ms_per_decision"] = 1000.0 * wall / max(1, res.stats["decisions"])
-    log(f"  host {out['host_ms_per_decision']:.1f} ms a decision ({res.stats['decisions']} decisions, zero latency)")
-    with ScriptedServer(latency=latency, jitter=0.25, concurrency=concurrency, policy=_policy) as srv:
-        res_b, wall_b = _run(batched_es, srv, concurrency, concurrency, views, sim, None)
-        _, wall_s = _run(es.subset(range(n_seq)), srv, 1, 1, views, sim, None)
+    with _shared(es, sim, views) as shared:
+        # host cost per decision: zero-latency server, after a warm-up (compilation, render contexts)
+        with ScriptedServer(latency=0.0, concurrency=concurrency, policy=_policy) as srv:
+            warm = es.subset(range(min(concurrency, len(es))))
+            _run(warm, srv, concurrency, concurrency, views, sim, None, shared)
+            _run(es.subset(range(1)), srv, 1, 1, views, sim, None, shared)  # the sequential loop's programs too
+            res, wall = _run(warm, srv, concurrency, concurrency, views, sim, None, shared)
+        out["host_ms_per_decision"] = 1000.0 * wall / max(1, res.stats["decisions"])
+        log(f"  host {out['host_ms_per_decision']:.1f} ms a decision ({res.stats['decisions']} decisions, zero latency)")
+        with ScriptedServer(latency=latency, jitter=0.25, concurrency=concurrency, policy=_policy) as srv:
+            res_b, wall_b = _run(batched_es, srv, concurrency, concurrency, views, sim, None, shared)
+            _, wall_s = _run(es.subset(range(n_seq)), srv, 1, 1, views, sim, None, shared)
     eph_b = 3600.0 * len(batched_es) / wall_b
     eph_s = 3600.0 * n_seq / wall_s
     out["episodes_per_hour"] = {"batched": eph_b, "sequential": eph_s}
@@ -177,9 +196,6 @@ def bench_vllm(es, quick: bool, views) -> dict:
     batched_es = small.subset(range(1, 1 + n_b))
     seq_es = small.subset(range(1 + n_b, 1 + n_b + n_s))
     sim = SimConfig(max_steps=VLLM_MAX_STEPS)
-    # the same images, rendered in the loop's own process: every run builds its renderer anew, and render
-    # worker processes would add their start-up and shut-down (seconds each) to every run's wall time
-    views = views.replace(workers=1)
     opts = {"temperature": 0.0, "structured": "json_schema", "max_tokens": VLLM_MAX_TOKENS, "timeout_s": 300.0}
     out = {"max_num_seqs": VLLM_MAX_NUM_SEQS, "in_flight": {"batched": VLLM_BATCH, "sequential": 1},
            "max_steps": sim.max_steps, "max_tokens": VLLM_MAX_TOKENS, "render_workers": views.workers,
@@ -195,16 +211,17 @@ def bench_vllm(es, quick: bool, views) -> dict:
 
             starting = pool.submit(start)  # the server starts while the loop's programs compile
             try:
+                shared = stack.enter_context(_shared(small, sim, views))
                 with ScriptedServer(latency=0.0, concurrency=VLLM_BATCH, policy=_policy) as scripted:
-                    _run(small.subset(range(VLLM_BATCH)), scripted, VLLM_BATCH, VLLM_BATCH, views, sim, None)
-                    _run(warm_es, scripted, 1, 1, views, sim, None)
+                    _run(small.subset(range(VLLM_BATCH)), scripted, VLLM_BATCH, VLLM_BATCH, views, sim, None, shared)
+                    _run(warm_es, scripted, 1, 1, views, sim, None, shared)
             except BaseException:
                 wait([starting])  # then the stack stops the server
                 raise
             server, out["server_start_s"] = starting.result()
-            _run(warm_es, server, 1, 1, views, sim, None, **opts)  # warm-up: the server's first requests
-            res_b, _ = _run(batched_es, server, VLLM_BATCH, VLLM_BATCH, views, sim, None, **opts)
-            res_s, _ = _run(seq_es, server, 1, 1, views, sim, None, **opts)
+            _run(warm_es, server, 1, 1, views, sim, None, shared, **opts)  # warm-up: the server's first requests
+            res_b, _ = _run(batched_es, server, VLLM_BATCH, VLLM_BATCH, views, sim, None, shared, **opts)
+            res_s, _ = _run(seq_es, server, 1, 1, views, sim, None, shared, **opts)
     except VllmServerError as exc:
         log(f"  vLLM: {exc}")
         return {"failed": str(exc).splitlines()[0]}

@@ -242,23 +242,31 @@ class HostLoop:
     """One agent over an episode set (:func:`run_llm_agent` builds and runs it)."""
 
     def __init__(self, es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, *, sim: T.SimConfig, views: ViewConfig,
-                 batch: int, seed: int, costs, out: Path | None, save_images: int, progress: bool):
+                 batch: int, seed: int, costs, out: Path | None, save_images: int, progress: bool, world=None,
+                 renderer=None):
         from ignjax.evaluate.runner import make_world
 
         self.es, self.agent, self.llm, self.sim, self.views = es, agent, llm, sim, views
         self.seed, self.costs, self.out, self.save_images, self.progress = seed, tuple(costs), out, save_images, progress
-        self.world = make_world(es, sim)
+        if world is not None and world.config != sim:
+            raise ConfigError(None, "world", "the given world was made with other simulator settings")
+        self.world = world if world is not None else make_world(es, sim)
         E.check_specs(self.world, es.specs)
         self.n = len(es)
         self.B = max(1, min(int(batch), self.n))
         self.keys = episode_keys(seed, np.arange(self.n))
         self.names = self._view_names()
         self.categories = es.bank.categories
-        self.renderer = None
-        if agent.observation == "panel":  # made before the first request: render workers start here
+        self.renderer, self._own_renderer = None, False
+        if agent.observation == "panel" and renderer is not None:
+            if renderer.bank is not es.bank or renderer.sim != sim or renderer.config != views:
+                raise ConfigError(None, "renderer", "the given renderer was made for another bank, simulator settings "
+                                                    "or view settings")
+            self.renderer = renderer
+        elif agent.observation == "panel":  # made before the first request: render workers start here
             from ignjax.sim.views import ViewRenderer
 
-            self.renderer = ViewRenderer(es.bank, sim, views)
+            self.renderer, self._own_renderer = ViewRenderer(es.bank, sim, views), True
         w = self.world
         self._reset = lambda *a: _reset_rows(w, *a)
         self._reset_all = lambda *a: _reset_all(w, *a)
@@ -557,6 +565,7 @@ class HostLoop:
                     need = sorted(set(r for r in np.flatnonzero(step_mask & ~done_now)) | set(refilled))
                 stats = client.stats()
                 util = client.utilisation(t_stats0)
+                wall = time.perf_counter() - t_start
         finally:
             if log:
                 log.close()
@@ -564,10 +573,10 @@ class HostLoop:
                 bar.close()
             if cache is not None:
                 cache.close()
-            if self.renderer is not None:
+            if self.renderer is not None and self._own_renderer:
                 self.renderer.close()
         records.update(finished)
-        return self._result(records, {"wall_s": time.perf_counter() - t_start, "decisions": decisions,
+        return self._result(records, {"wall_s": wall, "decisions": decisions,
                                       "utilisation": util, "requests": stats.requests_sent,
                                       "max_in_flight": stats.max_in_flight, "resumed": len(finished)})
 
@@ -688,7 +697,8 @@ def dry_run(agent: LLMAgent, n_episodes: int, *, sim: T.SimConfig = T.SimConfig(
 
 def run_llm_agent(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, *, sim: T.SimConfig = T.SimConfig(),
                   views: ViewConfig = ViewConfig(size=224), batch: int = 64, seed: int = 0, costs=LOCKED_COSTS,
-                  out: str | os.PathLike | None = None, save_images: int = 0, progress: bool = False) -> LoopResult:
+                  out: str | os.PathLike | None = None, save_images: int = 0, progress: bool = False, world=None,
+                  renderer=None) -> LoopResult:
     """Run an MLLM agent over every episode of ``es`` (module docstring).
 
     Args:
@@ -708,6 +718,12 @@ def run_llm_agent(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, *, sim: T.Sim
             ``images/<agent>/<episode id>/<step>_panel.jpg`` (for the viewer).
         progress: show a progress bar (episodes, ETA, requests in flight,
             tokens, retries).
+        world: a :class:`~ignjax.sim.env.World` made from ``es`` (or the set it
+            was cut from) with ``sim``, to share across runs (default: made here).
+        renderer: a :class:`~ignjax.sim.views.ViewRenderer` of ``es.bank`` with
+            ``sim`` and ``views``, to share across runs (its render processes
+            and contexts stay warm; the caller closes it). Default: one made
+            for this run and closed at its end.
 
     Raises:
         ReplayMissError: under ``llm.replay``, a request not in the cache.
@@ -719,7 +735,8 @@ def run_llm_agent(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, *, sim: T.Sim
     if overrides:  # e.g. the observation ablation's view count, the no-QA variant's upfront description
         sim = dataclasses.replace(sim, **overrides)
     loop = HostLoop(es, agent, llm, sim=sim, views=views, batch=batch, seed=seed, costs=costs,
-                    out=Path(out) if out is not None else None, save_images=save_images, progress=progress)
+                    out=Path(out) if out is not None else None, save_images=save_images, progress=progress,
+                    world=world, renderer=renderer)
     return asyncio.run(loop.run())
 
 
