@@ -17,7 +17,8 @@ slice alike. Each device runs its share of the episodes (and, in a sweep,
 every setting of them) with no communication; the batch is padded with
 finished copies to equal shards, and every row runs at the vectorised
 widths of the whole batch, so a row's result does not depend on the device
-count (tested bitwise).
+count (tested bitwise) as long as each device's share holds a chunk
+(:func:`_shard_widths`).
 
 Agents are pure functions (:class:`ignjax.agents.Agent`): ``init`` and
 ``act`` see the :class:`~ignjax.sim.types.Observation` and the oracle's
@@ -173,11 +174,26 @@ def _shard_rows(n: int, copies: int, parts: int, widths: tuple[int, int, int]) -
     """Episodes per device when ``n`` episodes (each run ``copies`` times)
     are sharded over ``parts`` devices at these ``widths``: at least its share
     of ``n``, and enough, with ``copies``, for whole agent chunks and a full
-    simulator chunk, so that every row runs at the widths of the whole batch."""
+    simulator chunk, so that every row runs at these widths."""
     act, sim, group = widths
     m = max(-(-n // parts), -(-max(sim, group) // copies))
     step = act // math.gcd(act, copies)
     return -(-m // step) * step
+
+
+def _shard_widths(n: int, copies: int, parts: int, chunk: int | None) -> tuple[int, int, int]:
+    """The widths rows run at when ``n`` episodes (each run ``copies``
+    times) are sharded over ``parts`` devices: the whole batch's
+    (:func:`_widths`), so that a row's result does not depend on the device
+    count, unless a device's share of the rows is smaller than a chunk
+    (more devices than chunks: with the default chunk, more than
+    :data:`ignjax.sim.compact.CHUNKS`); then the share's, rather than
+    padding every device to a whole chunk."""
+    widths = _widths(n * copies, n, chunk)
+    share = -(-n // parts)
+    if share * copies < max(widths):
+        widths = _widths(share * copies, share, chunk)
+    return widths
 
 
 _REPLICAS: dict = {}
@@ -207,7 +223,7 @@ def _sharded(fn, world, specs, agent, params, keys, chunk, parts: int, copies: i
     finished copies to ``parts`` equal shards (:func:`_shard_rows`); the
     outputs' episode axis is ``out_axis``, and the padding is cut from it."""
     n = specs.scene.shape[0]
-    widths = _widths(n * copies, n, chunk)
+    widths = _shard_widths(n, copies, parts, chunk)
     size = _shard_rows(n, copies, parts, widths) * parts
     specs, keys = pad_batch(specs, keys, size)
     mesh = device_mesh(parts)
@@ -347,7 +363,9 @@ def rollout(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.Array, 
     count, with the episodes sharded over ``parts`` devices. E need not
     divide by ``parts``: the batch is padded with finished copies of the
     last episode, which are cut from the result. Each row's result is the
-    same whatever ``parts`` is.
+    same whatever ``parts`` is, up to :data:`ignjax.sim.compact.CHUNKS`
+    devices with the default ``chunk`` (with more, the rows run at the
+    shards' widths, and float rounding can change a rare episode).
 
     Args:
         keys: (E,) per-episode keys (see :func:`episode_keys`), or one key

@@ -19,7 +19,10 @@ from ignjax.agents import get_agent
 from ignjax.devices import ENV_VAR, configure_cpu_devices
 from ignjax.errors import ConfigError
 from ignjax.protocol import LOCKED_COSTS
-from ignjax.sim.rollout import _shard_rows, _widths, batch_parts, episode_keys, pad_specs, rollout, rollout_sweep
+from ignjax.sim.compact import CHUNKS
+from ignjax.sim.rollout import (
+    _shard_rows, _shard_widths, _widths, batch_parts, episode_keys, pad_specs, rollout, rollout_sweep,
+)
 
 two_devices = pytest.mark.skipif(jax.device_count() < 2, reason=f"needs 2 devices (set {ENV_VAR}=2 or more)")
 
@@ -63,19 +66,26 @@ def test_parts_counts_devices():
 
 @pytest.mark.parametrize("n, copies, parts, chunk", [
     (40, 1, 1, None), (39, 1, 2, None), (37, 1, 2, None), (40, 3, 2, 8), (39, 2, 2, None), (5, 1, 2, 8),
-    (4096, 1, 2, None), (500, 16, 4, None), (3, 1, 16, None), (1, 4, 2, None),
+    (4096, 1, 2, None), (4096, 1, 8, None), (4096, 1, 32, None), (500, 16, 4, None), (3, 1, 16, None), (1, 4, 2, None),
 ])
-def test_shards_hold_whole_chunks_of_the_batch_widths(n, copies, parts, chunk):
+def test_shards_hold_whole_chunks(n, copies, parts, chunk):
     """Every shard holds its share of the episodes, whole agent chunks and at
-    least one simulator chunk, at the widths of the whole batch; one device
-    pads nothing when the agent's chunk divides the rows."""
-    act, sim, group = _widths(n * copies, n, chunk)
-    m = _shard_rows(n, copies, parts, (act, sim, group))
+    least one simulator chunk; the widths are the whole batch's unless a
+    share is smaller than a chunk (more devices than chunks), and the
+    padding stays below a chunk per device."""
+    widths = _shard_widths(n, copies, parts, chunk)
+    act, sim, group = widths
+    m = _shard_rows(n, copies, parts, widths)
     assert m * parts >= n
     assert (m * copies) % act == 0 and m * copies >= max(sim, group)
-    assert m * parts - n < parts * act + max(sim, group)  # padding is bounded by the chunk sizes
-    if parts == 1 and (n * copies) % act == 0 and n * copies >= max(sim, group):
+    assert m * parts - n < parts * act + max(sim, group)
+    whole = _widths(n * copies, n, chunk)
+    if chunk is None and parts <= CHUNKS:
+        assert widths == whole
+    if parts == 1 and (n * copies) % act == 0:
         assert m == n
+    if n >= 1000:
+        assert m * parts < 1.1 * n  # large batches barely grow, however many devices
 
 
 def test_padding_keeps_padded_rows_padded(small_benchmark):
