@@ -164,7 +164,6 @@ def server_command(python: Path, model_dir: Path, port: int, *, max_num_seqs: in
         "--enforce-eager",
         "--seed",
         "0",
-        "--disable-log-stats",
     ]
 
 

@@ -148,6 +148,18 @@ def test_variants_restrict_what_may_be_asked():
                                "tandem-4v", "tandem-12v"}
 
 
+def test_route_hint_mode_and_follow_up_reach_the_prompt():
+    a = get_llm_agent("tandem")
+    hint = "Take the way to your left; it leads toward the kitchen."
+    d = _decision(answers=[(3, hint)], hint_active=True, last_move="You are getting closer to the area the last route "
+                                                                      "hint pointed to.")
+    text = a.state_text(TandemMemory(), d)
+    assert f"Active route hint: {hint}" in text and "Progress: You are getting closer" in text
+    assert "Active route hint" not in a.state_text(TandemMemory(), _decision(answers=[(3, hint)]))  # expired hint
+    follow = a.state_text(TandemMemory(), _decision(confirm=1, follow_up=T.FOLLOW_ONE_MOVE))
+    assert "make one closer move, then stop" in follow
+
+
 def test_spatial_memory_merges_belief_updates_unless_ablated():
     d = _decision()
     a = get_llm_agent("tandem")
@@ -192,7 +204,7 @@ SCRIPT = {1: _plan("ask", question_type=1), 2: _plan("ask", question_type=1),
           4: _plan("move", direction="front-right", subgoal="the corner by the window"), 5: _plan("stop"), 6: _plan("stop")}
 """Planner replies per turn: T1; T1 again (refused by safeguard 1, corrected to T2); two moves; a stop without
 evidence (turned into a confirmation); a stop."""
-CELLS = {"the open doorway": (1, 1), "the corner by the window": (8, 3)}
+CELLS = {"the open doorway": (1, 1), "the corner by the window": (8, 8)}
 """The Grounder's cells, by subgoal (grid corners)."""
 
 
@@ -219,7 +231,7 @@ def test_each_decision_path_end_to_end(episodes, tmp_path):
     kinds = [a[2][0] for a in acts]
     # T1, T2 (after the correction), move, move, confirmation (the unconfirmed stop), then the final decision
     assert [a[2][4] for a in acts[:2]] == [1, 2] and kinds[:2] == [ASK, ASK]
-    assert acts[2][2][:4] == [MOVE, 2, 1, 1] and acts[3][2][:4] == [MOVE, 7, 8, 3]  # view and the Grounder's cells
+    assert acts[2][2][:4] == [MOVE, 2, 1, 1] and acts[3][2][:4] == [MOVE, 7, 8, 8]  # view and the Grounder's cells
     assert acts[4][2] == [ASK, 0, 4, 1, 4]
     assert res.accounting["invalid_replies"].tolist() == [1]  # the repeated Type-1 question
     roles = [c["role"] for c in calls]
