@@ -156,7 +156,7 @@ class EvalConfig:
         agents: the agents evaluated: JAX-native agents (``ignjax.agents.registry()``) and MLLM agents
             (``ignjax.agents.llm.catalog.LLM_AGENTS``, e.g. ``vlm``; they need the ``[llm]`` table's server).
         batch: episodes per compiled rollout.
-        parts: concurrent pieces of each batch; 0: the default split (``ignjax.sim.rollout.batch_parts``, 2 on CPU).
+        parts: devices each batch is sharded over (``ignjax.sim.rollout``); 0: all of them.
         thresholds: success distances tau of the SR / OSR / WSR columns, m; positive and increasing.
         costs: per-type question costs charged by WSR (Type 1 appearance, 2 region, 3 route, 4 confirmation);
             default the paper's locked costs.
@@ -184,7 +184,7 @@ class EvalConfig:
         if self.batch < 1:
             raise ConfigError(None, "eval.batch", "must be >= 1")
         if self.parts < 0:
-            raise ConfigError(None, "eval.parts", f"must be >= 0 (0: the default split), got {self.parts}")
+            raise ConfigError(None, "eval.parts", f"must be >= 0 (0: all devices), got {self.parts}")
         if tuple(sorted(self.thresholds)) != self.thresholds or any(t <= 0 for t in self.thresholds):
             raise ConfigError(None, "eval.thresholds", "must be positive and increasing")
 

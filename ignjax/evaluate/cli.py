@@ -51,8 +51,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default="runs/eval", help="output folder (default runs/eval)")
     p.add_argument("--batch", type=int, default=256, help="episodes per compiled batch (default 256)")
     p.add_argument("--parts", type=int, default=0,
-                   help="concurrent pieces of each batch, one thread each (default 0: 2 on CPU, 1 on accelerators; "
-                        "more on machines with more cores)")
+                   help="devices each batch is sharded over (default 0: all; on a CPU one device per core, "
+                        "IGNJAX_CPU_DEVICES=N to change)")
     p.add_argument("--seed", type=int, default=0, help="seed of the agents' randomness (default 0)")
     p.add_argument("--scenes-root", help="where to look for scene files the episode file names, if not next to it")
     p.add_argument("--thresholds", default=",".join(f"{t:g}" for t in SUCCESS_THRESHOLDS),
