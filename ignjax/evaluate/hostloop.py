@@ -58,7 +58,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ignjax.agents.llm.agent import ASK, MOVE, Decision, LLMAgent
+from ignjax.agents.llm.agent import ASK, MOVE, MOVED_M, Decision, LLMAgent
 from ignjax.agents.llm.cache import ResponseCache
 from ignjax.agents.llm.client import ChatClient, ImagePart, LLMRequestError
 from ignjax.agents.llm.config import LLMConfig
@@ -149,7 +149,7 @@ def _last_move_text(obs: dict, r: int, kind: int) -> str:
     if kind != MOVE:
         return ""
     moved = float(obs["last_move"][r])
-    if moved < 0.05:
+    if moved < MOVED_M:
         return "the way was blocked; you did not move."
     return f"you moved {moved:.1f} m" + ("; part of the way was blocked." if obs["blocked"][r].any() else ".")
 
@@ -323,7 +323,8 @@ class HostLoop:
                        "room": int(obs["room_label"][r]), "known": ans.known[r].tolist(),
                        "goal_room": int(ans.room_label[r]) if ans.known[r][1] else -1, "confirm": int(ans.confirm[r]),
                        "follow_up": int(ans.follow_up[r]), "hint_active": bool(ans.hint_active[r]),
-                       "hint_progress": int(ans.hint_progress[r]), "blocked": obs["blocked"][r].tolist()}
+                       "hint_progress": int(ans.hint_progress[r]), "blocked": obs["blocked"][r].tolist(),
+                       "moved": float(obs["last_move"][r])}
             rec = self.es.records[ep.index]
             text = None if self.agent.observation == "panel" else observation_text(obs, r, self.categories, self.names)
             last_kind = ep.calls[-1]["action"][0] if ep.calls and ep.calls[-1].get("action") else -1

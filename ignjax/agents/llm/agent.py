@@ -43,6 +43,9 @@ from ignjax.sim.views.compose import view_names
 MOVE, ASK, STOP = 0, 1, 2
 """Action kinds (the values of :data:`ignjax.sim.types.MOVE` etc.)."""
 
+MOVED_M = 0.05
+"""A MOVE that covered less than this (m) did not move: the way was blocked."""
+
 QUESTION_NAMES = {1: "appearance", 2: "region", 3: "route", 4: "confirmation"}
 QUESTION_HELP = {
     1: "what the target looks like (colour, material, size, state, what it stands on or near)",
@@ -98,7 +101,8 @@ class Decision:
             ``confirm`` the last Type-4 answer (1 yes, 0 no, -1 none),
             ``follow_up`` (1 stop now, 2 one closer move, 0 none),
             ``hint_active``, ``hint_progress`` (:data:`ignjax.sim.types.HINT_*`),
-            ``blocked`` (8,) bool sectors blocked in the last move.
+            ``blocked`` (8,) bool sectors blocked in the last move, ``moved``
+            metres the last move covered.
     """
 
     episode: str
@@ -280,5 +284,5 @@ class VlmAgent(LLMAgent):
                            schema=decision_schema(d.n_views), tag=d.episode)
 
 
-__all__ = ["ASK", "Decision", "EpisodeMemory", "LLMAgent", "MOVE", "QUESTION_NAMES", "STOP", "VlmAgent",
+__all__ = ["ASK", "Decision", "EpisodeMemory", "LLMAgent", "MOVE", "MOVED_M", "QUESTION_NAMES", "STOP", "VlmAgent",
            "decision_schema"]

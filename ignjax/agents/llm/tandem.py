@@ -66,7 +66,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from ignjax.agents.llm.agent import ASK, MOVE, QUESTION_HELP, QUESTION_NAMES, STOP, Decision, LLMAgent
+from ignjax.agents.llm.agent import ASK, MOVE, MOVED_M, QUESTION_HELP, QUESTION_NAMES, STOP, Decision, LLMAgent
 from ignjax.agents.llm.client import ChatRequest
 from ignjax.sim import types as T
 from ignjax.sim.views.compose import view_names
@@ -160,6 +160,17 @@ class TandemMemory:
 
 def _clip(text, n: int = TEXT_CHARS) -> str:
     return " ".join(str(text or "").split())[:n]
+
+
+def _cell(parsed, err):
+    """``((col, row), None)`` from a reply's grid cell, or ``(None, why)``."""
+    if parsed is None:
+        return None, err or "the reply is not a JSON object"
+    for key in ("col", "row"):
+        v = parsed.get(key)
+        if isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= 8:
+            return None, f"field '{key}' must be an integer from 1 to 8"
+    return (parsed["col"], parsed["row"]), None
 
 
 def _rear(k: int, n: int) -> bool:
@@ -460,7 +471,7 @@ class Tandem(LLMAgent):
         """Fold the last step's outcome (executor feedback, answers) into memory."""
         p = d.percept
         if m.moves and m.moves[-1][4] == "" and m.history and m.history[-1][1] == "move":
-            moved_blocked = "blocked" if "did not move" in d.last_move else "moved"
+            moved_blocked = "blocked" if p.get("moved", 1.0) < MOVED_M else "moved"
             s, n, g, r, _ = m.moves[-1]
             m.moves[-1] = (s, n, g, r, moved_blocked)
         if m.questions and m.questions[-1][1] == 4 and m.questions[-1][0] == d.step - 1:
@@ -491,11 +502,10 @@ class Tandem(LLMAgent):
         if act is None:
             return None, why
         if act[0] == MOVE and not self.two_stage:
-            for key in ("col", "row"):
-                v = parsed.get(key)
-                if isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= 8:
-                    return None, f"field '{key}' must be an integer from 1 to 8"
-            act = (MOVE, act[1], parsed["col"], parsed["row"], 1)
+            cell, why = _cell(parsed, None)
+            if cell is None:
+                return None, why
+            act = (MOVE, act[1], *cell, 1)
         return (act, parsed), None
 
     async def _ground(self, ctx, m: TandemMemory, d: Decision, act, parsed):
@@ -503,17 +513,7 @@ class Tandem(LLMAgent):
             return act
         k = act[1]
         req = self.grounder_request(d, ctx.view_image(k), _clip(parsed.get("subgoal")), _clip(parsed.get("purpose")))
-
-        def cell(p, err):
-            if p is None:
-                return None, err or "the reply is not a JSON object"
-            for key in ("col", "row"):
-                v = p.get(key)
-                if isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= 8:
-                    return None, f"field '{key}' must be an integer from 1 to 8"
-            return (p["col"], p["row"]), None
-
-        got = await ctx.query(req, cell, role="grounder")
+        got = await ctx.query(req, _cell, role="grounder")
         col, row = got if got is not None else GROUNDER_FALLBACK
         return (MOVE, k, col, row, 1)
 
