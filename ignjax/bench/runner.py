@@ -31,7 +31,9 @@ process, on the same inputs:
 
 ``--json``: the last line of stdout is one JSON object with every figure.
 ``--llm``: only the MLLM host loop's figures (:mod:`ignjax.bench.llm`).
-``--scaling``: only the scaling figures.
+``--scaling``: only how cost grows (:mod:`ignjax.bench.scaling`): steps/s and
+memory against batch size, scenes in the bank, devices and cost vectors, as
+``scaling.png`` and ``scaling.json`` in ``--out``.
 
 The ray figures are :mod:`ignjax.bench.rays`, the rollout and study figures
 :mod:`ignjax.bench.rollouts`; this module is the command line.
@@ -43,37 +45,8 @@ import argparse
 import json
 import sys
 
-from ignjax.bench.timing import log, time_interleaved
-
-SCALING_BATCH = 4096
-"""Episodes of the EIG rollout the scaling figures time."""
-SCALING_REPEATS = 3
-
-
-def bench_scaling(es, world, batch: int = SCALING_BATCH) -> dict:
-    """Decision steps/s of the EIG agent's rollout of ``batch`` episodes
-    sharded over 1, 2 and all devices (those there are), compiled first and
-    then timed in turns (:func:`ignjax.bench.timing.time_interleaved`).
-
-    Returns:
-        {"batch": batch, "devices": {str(count): steps/s}}.
-    """
-    import jax
-    import numpy as np
-
-    from ignjax.agents import get_agent
-    from ignjax.sim.rollout import episode_keys, rollout
-
-    agent = get_agent("eig")
-    params = agent.default_params()
-    idx = np.arange(batch) % len(es)
-    specs = jax.tree.map(lambda a: a[idx], es.specs)
-    keys = episode_keys(0, np.arange(batch))
-    counts = sorted({c for c in (1, 2, jax.device_count()) if c <= jax.device_count()})
-    runs = [lambda c=c: jax.block_until_ready(rollout(world, specs, agent, params, keys, parts=c)) for c in counts]
-    steps = {c: float(np.asarray(run()[0].steps).sum()) for c, run in zip(counts, runs)}  # compile
-    best = time_interleaved(runs, SCALING_REPEATS)
-    return {"batch": batch, "devices": {str(c): steps[c] / dt for c, dt in zip(counts, best)}}
+from ignjax.bench.scaling import SCALING_BATCH, bench_devices
+from ignjax.bench.timing import log
 
 
 def main(argv=None) -> int:
@@ -83,7 +56,9 @@ def main(argv=None) -> int:
     p.add_argument("--json", action="store_true", help="end stdout with one JSON line of every figure")
     p.add_argument("--episodes", help="episode file for the rollouts (default: the shipped benchmark)")
     p.add_argument("--scaling", action="store_true",
-                   help=f"only the scaling figures (EIG agent, B = {SCALING_BATCH}, sharded over 1, 2 and all devices)")
+                   help="only how cost grows: EIG decision steps/s and memory against batch size, scenes in the bank, "
+                        "devices and cost vectors; writes OUT/scaling.png and OUT/scaling.json (ignjax.bench.scaling)")
+    p.add_argument("--out", default="runs/bench", help="output folder of --scaling's figure (default runs/bench)")
     p.add_argument("--llm", action="store_true",
                    help="only the MLLM loop's figures (the llm block: batched vs sequential episodes per hour against "
                         "the local scripted server, utilisation, host ms per decision; ignjax.bench.llm)")
@@ -111,7 +86,14 @@ def main(argv=None) -> int:
         print(json.dumps(res, sort_keys=True) if args.json else json.dumps(res, indent=2, sort_keys=True))
         return 0
     if args.scaling:
-        res["scaling"] = _scaling(load_benchmark(args.episodes or SHIPPED_BENCHMARK))
+        from ignjax.bench.scaling import growth_curves, write_growth
+
+        es = load_benchmark(args.episodes or SHIPPED_BENCHMARK)
+        log("how cost grows (EIG rollout) ...")
+        res["scaling"] = growth_curves(es, make_world(es), args.quick)
+        res["scaling"]["device"] = device
+        res["scaling"]["files"] = write_growth(res["scaling"], args.out)
+        log(f"  wrote {res['scaling']['files']['png']}")
         print(json.dumps(res, sort_keys=True) if args.json else json.dumps(res, indent=2, sort_keys=True))
         return 0
     log("rays ...")
@@ -146,11 +128,11 @@ def main(argv=None) -> int:
 
 
 def _scaling(es, world=None) -> dict:
-    """:func:`bench_scaling`, with its progress lines."""
+    """:func:`ignjax.bench.scaling.bench_devices`, with its progress lines."""
     from ignjax.evaluate.runner import make_world
 
     log(f"scaling: EIG rollout at B = {SCALING_BATCH} over 1, 2 and all devices ...")
-    out = bench_scaling(es, world or make_world(es))
+    out = bench_devices(es, world or make_world(es))
     log("  " + ", ".join(f"{c} devices {v:.0f} decision steps/s" for c, v in out["devices"].items()))
     return out
 

@@ -216,6 +216,18 @@ def _replicated(world: World, mesh: Mesh) -> World:
     return copy
 
 
+def _sharded_args(fn, world, specs, agent, params, keys, chunk, parts: int, copies: int, out_axis: int):
+    """The arguments of :func:`_run_sharded` for :func:`_sharded` (episodes
+    padded to ``parts`` equal shards): (args, static keyword arguments, padded rows)."""
+    n = specs.scene.shape[0]
+    widths = _shard_widths(n, copies, parts, chunk)
+    size = _shard_rows(n, copies, parts, widths) * parts
+    specs, keys = pad_batch(specs, keys, size)
+    mesh = device_mesh(parts)
+    return ((_replicated(world, mesh), specs, params, keys),
+            dict(fn=fn, agent=agent, widths=widths, mesh=mesh, out_axis=out_axis), size)
+
+
 def _sharded(fn, world, specs, agent, params, keys, chunk, parts: int, copies: int, out_axis: int):
     """``fn(world, specs, agent, params, keys, widths)`` with the episode axis
     of ``specs`` and ``keys`` split over ``parts`` devices, each episode run
@@ -223,12 +235,8 @@ def _sharded(fn, world, specs, agent, params, keys, chunk, parts: int, copies: i
     finished copies to ``parts`` equal shards (:func:`_shard_rows`); the
     outputs' episode axis is ``out_axis``, and the padding is cut from it."""
     n = specs.scene.shape[0]
-    widths = _shard_widths(n, copies, parts, chunk)
-    size = _shard_rows(n, copies, parts, widths) * parts
-    specs, keys = pad_batch(specs, keys, size)
-    mesh = device_mesh(parts)
-    out = _run_sharded(_replicated(world, mesh), specs, params, keys, fn=fn, agent=agent, widths=widths, mesh=mesh,
-                       out_axis=out_axis)
+    args, static, size = _sharded_args(fn, world, specs, agent, params, keys, chunk, parts, copies, out_axis)
+    out = _run_sharded(*args, **static)
     if size == n:
         return out
     return jax.tree.map(lambda a: jax.lax.slice_in_dim(a, 0, n, axis=out_axis), out)
@@ -402,6 +410,31 @@ def rollout_sweep(world: World, specs: T.EpisodeSpec, agent, params_batch, keys:
     keys = _keys(keys, n)
     K = jax.tree.leaves(params_batch)[0].shape[0]
     return _sharded(_rollout_sweep, world, specs, agent, params_batch, keys, chunk, batch_parts(n, parts), K, 1)
+
+
+def rollout_memory(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.Array, chunk: int | None = None,
+                   parts: int | None = None, sweep: bool = False) -> dict:
+    """XLA's memory analysis of the program :func:`rollout` (or, with
+    ``sweep``, :func:`rollout_sweep`, ``params`` with a leading K axis) runs
+    for these arguments, per device, in bytes: ``arguments`` (the world's
+    copy, the specs, parameters and keys), ``outputs``, ``temporaries``
+    (the scan's state and every intermediate buffer XLA keeps at once) and
+    ``peak`` (their sum less what outputs alias from arguments): the memory
+    the compiled program needs on one device, whatever the backend reports
+    at run time (the CPU backend keeps no allocation statistics). Compiles
+    the program (the compilation cache makes a later call with the same
+    shapes free)."""
+    n = specs.scene.shape[0]
+    keys = _keys(keys, n)
+    fn, copies, out_axis = _rollout, 1, 0
+    if sweep:
+        fn, copies, out_axis = _rollout_sweep, jax.tree.leaves(params)[0].shape[0], 1
+    args, static, _ = _sharded_args(fn, world, specs, agent, params, keys, chunk, batch_parts(n, parts), copies,
+                                    out_axis)
+    m = _run_sharded.lower(*args, **static).compile().memory_analysis()
+    arg, out, tmp = int(m.argument_size_in_bytes), int(m.output_size_in_bytes), int(m.temp_size_in_bytes)
+    alias = int(getattr(m, "alias_size_in_bytes", 0))
+    return {"arguments": arg, "outputs": out, "temporaries": tmp, "peak": arg + out + tmp - alias}
 
 
 def pad_specs(specs: T.EpisodeSpec, size: int) -> T.EpisodeSpec:
