@@ -77,6 +77,9 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--llm-cache", default=None, help="response cache folder (default OUT/llm_cache)")
     g.add_argument("--llm-replay", action="store_true", help="answer from the cache only; a miss is an error naming "
                                                              "the request's hash")
+    g.add_argument("--llm-paraphrase", action="store_true",
+                   help="have the model reword each oracle answer before the agent reads it (a rewording that breaks "
+                        "the answer's rules is dropped for the template); same as --set llm.paraphrase=true")
     g.add_argument("--llm-concurrency", type=int, default=None, help="requests in flight per endpoint (default 16)")
     g.add_argument("--llm-batch", type=int, default=64, help="episodes in flight at once (default 64)")
     g.add_argument("--dry-run", action="store_true",
@@ -141,6 +144,8 @@ def llm_settings(args, sections: dict, out_dir: Path):
         d["api_key_env"] = args.llm_key_env
     if args.llm_concurrency is not None:
         d["concurrency"] = args.llm_concurrency
+    if args.llm_paraphrase:
+        d["paraphrase"] = True
     if args.llm_replay:
         d["replay"] = True
     d.setdefault("cache_dir", str(args.llm_cache or out_dir / "llm_cache"))
@@ -194,7 +199,7 @@ def run(args) -> int:
     from ignjax.agents.params import make_params, param_values_of
     from ignjax.episodes.dataset import load_benchmark
     from ignjax.evaluate.runner import make_world, run_agent
-    from ignjax.evaluate.outcomes import (TRAJECTORY_FILE, metric_rows, model_totals, outcome_rows,
+    from ignjax.evaluate.outcomes import (TRAJECTORY_FILE, metric_rows, model_totals, outcome_rows, per_episode_text,
                                           write_metric_table, write_outcomes, write_trajectories)
 
     from ignjax.agents.llm.catalog import LLM_AGENTS, get_llm_agent
@@ -230,7 +235,7 @@ def run(args) -> int:
         if agent.name in LLM_AGENTS:
             res = run_llm_agent(es, agent, llm, sim=sim, views=views, batch=args.llm_batch, seed=args.seed, costs=costs,
                                 out=out_dir, save_images=args.save_images, progress=not args.quiet)
-            rows += outcome_rows(agent.name, es.records, res.outcomes, res.accounting)
+            rows += outcome_rows(agent.name, es.records, res.outcomes, res.accounting, llm.prices)
             trajectories[agent.name] = res.trajectories
             write_transcripts(out_dir, agent.name, res.transcripts)
             used[agent.name] = {"options": {k: v for k, v in vars(agent).items()}, "llm": llm.public_dict(),
@@ -263,11 +268,15 @@ def run(args) -> int:
     print(M.success_rule(args.require_stop))
     if all(t in thresholds for t in SUCCESS_THRESHOLDS):
         print(M.table1(metrics, "text"))
-    for name, totals in model_totals(rows, llm.prices if llm else None).items():
+    for name, totals in run_record["model_totals"].items():
         cost = f", estimated cost {totals['cost_usd']:.4f} USD" if totals["cost_usd"] is not None else ""
+        rejected = (f", {totals['paraphrase_rejected']} paraphrases refused (template used)"
+                    if llm is not None and llm.paraphrase else "")
         print(f"{name}: {totals['requests']} requests, {totals['cache_hits']} cache hits, "
               f"{totals['prompt_tokens']} + {totals['completion_tokens']} tokens, {totals['retries']} retries, "
-              f"{totals['invalid_replies']} invalid replies, {totals['failures']} episodes ended by model failure{cost}")
+              f"{totals['invalid_replies']} invalid replies, {totals['failures']} episodes ended by model failure"
+              f"{rejected}{cost}")
+        print(f"{name}: {per_episode_text(totals)}")
     print(f"wrote {p_parquet}, {p_csv}, {out_dir / 'metrics.csv'}, {out_dir / TRAJECTORY_FILE} and "
           f"{out_dir / 'run.json'} (view the episodes: python -m ignjax.view {out_dir})")
     return 0

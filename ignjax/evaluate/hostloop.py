@@ -30,6 +30,23 @@ spent) end that episode with stop reason ``model_failure`` and the reason in
 ``failure``; the other episodes continue. A cache miss under replay ends the
 run with the request's hash.
 
+Question texts: an agent that writes its questions
+(:attr:`~ignjax.agents.llm.agent.LLMAgent.writes_questions`) hands the text
+of an ASK to ``ctx.note_question``; the decision's transcript record carries
+it as ``question`` ("" when the agent's controller asked without one), and
+:func:`question_texts` collects them (the Type-3 content analysis reads
+them). The oracle answers by type either way.
+
+Paraphrase (``llm.paraphrase``): before a decision, each oracle answer the
+agent has not read yet (refusals excepted) is sent through the same client
+(:func:`ignjax.sim.oracle_text.paraphrase_messages`; one request per answer,
+no re-ask, transcript role ``paraphrase``, counted like every model call);
+the rewording replaces the template in what the agent reads when
+:func:`ignjax.sim.oracle_text.paraphrase_leaks` finds nothing in it, and
+otherwise (or when the reply is unusable) the template stays and the
+episode's ``paraphrase_rejected`` counts it. An answer the agent never reads
+(asked at the episode's last step) is not paraphrased.
+
 Resume: every finished episode is appended to ``<out>/llm/<agent>.progress.jsonl``
 (flushed and synced). A run started again with the same settings skips the
 episodes found there and re-runs the others from their start; their earlier
@@ -60,7 +77,7 @@ import numpy as np
 
 from ignjax.agents.llm.agent import ASK, MOVE, MOVED_M, Decision, LLMAgent
 from ignjax.agents.llm.cache import ResponseCache
-from ignjax.agents.llm.client import ChatClient, ImagePart, LLMRequestError
+from ignjax.agents.llm.client import ChatClient, ChatRequest, ImagePart, LLMRequestError
 from ignjax.agents.llm.config import LLMConfig
 from ignjax.episodes.dataset import EpisodeSet
 from ignjax.errors import ConfigError, InputError
@@ -89,6 +106,7 @@ class _Episode:
     failure: str = ""
     progress: str = ""
     images: list = field(default_factory=list)
+    unread: list = field(default_factory=list)  # indices into answers still to paraphrase (llm.paraphrase)
 
 
 @dataclass
@@ -99,7 +117,8 @@ class LoopResult:
         outcomes: :class:`~ignjax.sim.types.OutcomeRow` of numpy arrays (E,).
         trajectories: :class:`~ignjax.sim.types.Trajectory` of numpy arrays (E, ...).
         accounting: column name -> (E,) array (:data:`ACCOUNTING`), plus ``failure`` (list of str).
-        stats: run totals: wall time, decisions, utilisation, requests in flight.
+        stats: run totals: wall time, decisions, utilisation, requests in flight,
+            ``paraphrased`` (paraphrase calls) and ``paraphrase_rejected``.
         transcripts: the transcript records (viewer schema plus request hash,
             image hashes, tokens, latency, cache hit), sorted by episode and step.
     """
@@ -201,6 +220,13 @@ class _Context:
     def __init__(self, loop: "HostLoop", client: ChatClient, ep: _Episode, d: Decision):
         self._loop, self._client, self._ep, self._d = loop, client, ep, d
         self.defaulted = False
+        self.question = ""
+
+    def note_question(self, text: str) -> None:
+        """Record the text of the question this decision asks (agents that
+        write their questions): the decision's transcript record carries it
+        as ``question``. The oracle answers by type; the text is a record."""
+        self.question = str(text)
 
     async def query(self, request, parse, role: str = "planner", reasks: int | None = None):
         """Send ``request``; ``parse(parsed, parse_error) -> (value, error)``
@@ -363,18 +389,41 @@ class HostLoop:
     async def _decide(self, client: ChatClient, ep: _Episode, d: Decision):
         """One decision (the agent's :meth:`~ignjax.agents.llm.agent.LLMAgent.decide`
         with a :class:`_Context`): ``("act", tuple)`` or ``("fail", reason)``."""
-        ctx = _Context(self, client, ep, d)
-        first = len(ep.calls)
         try:
+            d = await self._paraphrase(client, ep, d)
+            ctx = _Context(self, client, ep, d)
+            first = len(ep.calls)
             act = tuple(int(x) for x in await self.agent.decide(ctx, ep.memory, d))
         except LLMRequestError as e:
             return "fail", str(e)
         if len(ep.calls) == first:  # decided by the agent's controller alone: no model call
             ep.calls.append(self._call(d, None, None, act, [], None, role="controller"))
         ep.calls[-1]["action"] = list(act)
+        if act[0] == ASK and self.agent.writes_questions:
+            ep.calls[-1]["question"] = ctx.question
         if ctx.defaulted:
             ep.calls[-1]["error"] = "invalid replies: default action taken"
         return "act", act
+
+    async def _paraphrase(self, client: ChatClient, ep: _Episode, d: Decision) -> Decision:
+        """``d`` with the answers the agent has not read yet reworded by the model where the rewording passes
+        the checks (module docstring, ``llm.paraphrase``)."""
+        if not ep.unread:
+            return d
+        for i in ep.unread:
+            q, template = ep.answers[i]
+            req = ChatRequest(messages=OT.paraphrase_messages(q, template), schema=OT.PARAPHRASE_SCHEMA,
+                              schema_name="paraphrase", tag=d.episode)
+            text = await self._query(client, ep, d, req, _paraphrase_reply, "paraphrase", 0)
+            leaks = ["unusable reply"] if text is None else OT.paraphrase_leaks(q, text, template)
+            if leaks:
+                ep.acc["paraphrase_rejected"] += 1
+                why = ep.calls[-1]["error"] if text is None else "; ".join(leaks)
+                ep.calls[-1]["error"] = f"paraphrase refused, template used: {why}"
+            else:
+                ep.answers[i] = (q, text)
+        ep.unread = []
+        return dataclasses.replace(d, answers=tuple(ep.answers))
 
     async def _query(self, client: ChatClient, ep: _Episode, d: Decision, req, parse, role: str, reasks: int):
         """One model call with its re-asks: ``parse(parsed, parse_error) -> (value, error)``;
@@ -459,6 +508,7 @@ class HostLoop:
                 if self.sim.upfront_description:  # given at reset (and charged) as one Type-1 and one Type-2 answer
                     o = self.es.records[i]["oracle"]
                     slots[r].answers = [(1, o["appearance"]), (2, o["region"])]
+                    slots[r].unread = [0, 1] if self.llm.paraphrase else []
                 traj_rows[i] = []
                 rows.append(r)
                 idx.append(i)
@@ -539,6 +589,8 @@ class HostLoop:
                                 follow_up=int(answers.follow_up[r]), categories=self.categories,
                                 key=f"{er['episode_id']}:{int(before_step[r])}")
                             ep.answers.append((q, txt))
+                            if self.llm.paraphrase and not answers.refused[r]:
+                                ep.unread.append(len(ep.answers) - 1)
                         elif acts[r, 0] == MOVE:
                             ep.progress = OT.hint_progress_text(int(answers.hint_progress[r])) \
                                 if answers.hint_active[r] else ""
@@ -579,7 +631,11 @@ class HostLoop:
         records.update(finished)
         return self._result(records, {"wall_s": wall, "decisions": decisions,
                                       "utilisation": util, "requests": stats.requests_sent,
-                                      "max_in_flight": stats.max_in_flight, "resumed": len(finished)})
+                                      "max_in_flight": stats.max_in_flight, "resumed": len(finished),
+                                      "paraphrased": sum(c["role"] == "paraphrase" for r in records.values()
+                                                         for c in r["calls"]),
+                                      "paraphrase_rejected": sum(r["accounting"]["paraphrase_rejected"]
+                                                                 for r in records.values())})
 
     def _write_images(self, ep: _Episode) -> None:
         if self.out is None or not ep.images:
@@ -652,7 +708,9 @@ def dry_run(agent: LLMAgent, n_episodes: int, *, sim: T.SimConfig = T.SimConfig(
             llm: LLMConfig | None = None, costs=LOCKED_COSTS) -> dict:
     """What running ``agent`` on ``n_episodes`` episodes would send at most,
     before sending anything: requests (every decision a Planner call, every
-    decision a move for two-stage agents; re-asks not counted), images, and
+    decision a move for two-stage agents; with ``llm.paraphrase`` one
+    paraphrase per question, as many questions as the budget allows; re-asks
+    not counted), images, and
     an estimate of prompt tokens (text at 4 characters a token, images at one
     token per :data:`IMAGE_TOKEN_PX` square) and of completion tokens
     (``llm.max_tokens`` per request, the cap). The prompts are built from a
@@ -689,8 +747,16 @@ def dry_run(agent: LLMAgent, n_episodes: int, *, sim: T.SimConfig = T.SimConfig(
         g = agent.grounder_request(d, ImagePart(b"\xff\xd8\xff\xd9"), "the centre of the open doorway", "")
         grounder_tokens = text_tokens(g) + view_tokens
         out["prompt_tokens_per_grounder_request"] = grounder_tokens
-    out["requests"] = out["planner_requests"] + out["grounder_requests"]
-    out["prompt_tokens"] = decisions * planner_tokens + out["grounder_requests"] * grounder_tokens
+    paraphrase_tokens = 0
+    if llm is not None and llm.paraphrase and agent.may_ask:  # one per answer; a question per decision at most
+        out["paraphrase_requests"] = n_episodes * min(sim.max_questions, sim.max_steps)
+        route = OT.route_text(0, 2, -1, False, ())
+        paraphrase_tokens = text_tokens(ChatRequest(messages=OT.paraphrase_messages(3, route),
+                                                    schema=OT.PARAPHRASE_SCHEMA))
+        out["prompt_tokens_per_paraphrase_request"] = paraphrase_tokens
+    out["requests"] = out["planner_requests"] + out["grounder_requests"] + out.get("paraphrase_requests", 0)
+    out["prompt_tokens"] = (decisions * planner_tokens + out["grounder_requests"] * grounder_tokens
+                            + out.get("paraphrase_requests", 0) * paraphrase_tokens)
     max_tokens = (llm.max_tokens if llm is not None else LLMConfig().max_tokens)
     out["completion_tokens_at_most"] = out["requests"] * max_tokens
     return out
@@ -741,6 +807,23 @@ def run_llm_agent(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, *, sim: T.Sim
     return asyncio.run(loop.run())
 
 
+def _paraphrase_reply(parsed, err):
+    """A paraphrase reply's text, or ``(None, why)``."""
+    text = parsed.get("text") if isinstance(parsed, dict) else None
+    if not isinstance(text, str) or not text.strip():
+        return None, err or "field 'text' must be a non-empty string"
+    return " ".join(text.split()), None
+
+
+def question_texts(calls: list) -> list[dict]:
+    """The question texts of transcript records (``calls``: :attr:`LoopResult.transcripts`
+    or the lines of ``transcripts/<agent>.jsonl``): one ``{"episode": id, "step": s,
+    "type": t, "text": str}`` per ASK decision of an agent that writes its questions
+    ("" where it asked without one)."""
+    return [{"episode": c["episode"], "step": int(c["step"]), "type": int(c["action"][4]), "text": c["question"]}
+            for c in calls if "question" in c and c.get("action") and c["action"][0] == ASK]
+
+
 def write_transcripts(folder: str | os.PathLike, agent: str, calls: list) -> Path:
     """``<folder>/transcripts/<agent>.jsonl``: one record per model call, sorted by
     episode (file order) and step (:mod:`ignjax.view`'s transcript schema plus
@@ -750,4 +833,5 @@ def write_transcripts(folder: str | os.PathLike, agent: str, calls: list) -> Pat
     return path
 
 
-__all__ = ["ACCOUNTING", "HostLoop", "LoopResult", "observation_text", "run_llm_agent", "write_transcripts"]
+__all__ = ["ACCOUNTING", "HostLoop", "LoopResult", "observation_text", "question_texts", "run_llm_agent",
+           "write_transcripts"]

@@ -20,6 +20,11 @@ n_refused           questions refused (budget spent), not charged
 n_invalid           out-of-range actions clamped
 trace               question attempts as "type@step" (charged) or
                     "type@step!" (refused), separated by spaces
+requests ...        MLLM agents' model-call accounting
+                    (:data:`ACCOUNTING_COLUMNS`; zero for JAX-native agents)
+cost_usd            the episode's tokens at ``llm.prices`` (USD; cache hits
+                    included, as their tokens are; NaN for an MLLM agent
+                    without prices, 0 for a JAX-native agent)
 ==================  ==========================================================
 
 Everything the metrics need is in these columns: :func:`metric_rows`
@@ -56,16 +61,21 @@ from ignjax.sim.types import STOP_REASONS, OutcomeRow, Trajectory
 COLUMNS: tuple[str, ...] = (
     "agent", "episode_id", "scene_id", "difficulty", "final_distance", "final_euclidean", "min_distance",
     "path_length", "steps", "stopped", "stop_reason", "q1", "q2", "q3", "q4", "n_questions", "n_refused", "n_invalid",
-    "trace", "requests", "cache_hits", "prompt_tokens", "completion_tokens", "retries", "invalid_replies",
-    "model_latency_s", "failure",
+    "trace", "requests", "cache_hits", "prompt_tokens", "completion_tokens", "cost_usd", "retries", "invalid_replies",
+    "paraphrase_rejected", "model_latency_s", "failure",
 )
 ACCOUNTING_COLUMNS: tuple[str, ...] = ("requests", "cache_hits", "prompt_tokens", "completion_tokens", "retries",
-                                       "invalid_replies", "model_latency_s", "failure")
+                                       "invalid_replies", "paraphrase_rejected", "model_latency_s", "failure")
 """Model-call accounting of MLLM agents (:mod:`ignjax.evaluate.hostloop`): requests sent to a server (cache hits
-excluded), cache hits, tokens, HTTP retries, replies that could not be used, seconds spent waiting on the model in
-this run, and why an episode ended by model failure ("" otherwise). Zero (and "") for JAX-native agents; optional
-when a table is read (older tables have none)."""
-_ACCOUNTING_INTS = ("requests", "cache_hits", "prompt_tokens", "completion_tokens", "retries", "invalid_replies")
+excluded), cache hits, tokens, HTTP retries, replies that could not be used, oracle answers whose paraphrase was
+refused (``llm.paraphrase``: the template was shown instead), seconds spent waiting on the model in this run, and
+why an episode ended by model failure ("" otherwise). Zero (and "") for JAX-native agents; optional when a table
+is read (older tables have none)."""
+_ACCOUNTING_INTS = ("requests", "cache_hits", "prompt_tokens", "completion_tokens", "retries", "invalid_replies",
+                    "paraphrase_rejected")
+PER_EPISODE = ("calls", "prompt_tokens", "completion_tokens", "cost_usd")
+"""The per-episode figures of :func:`model_totals` (``calls``: requests sent plus cache hits, the episode's model
+calls whether or not the cache answered them, as its tokens and cost count them)."""
 
 
 def _trace(types, steps, charged) -> str:
@@ -83,10 +93,14 @@ def parse_trace(text: str) -> list[tuple[int, int, bool]]:
     return out
 
 
-def outcome_rows(agent: str, records: list[dict], out, accounting: dict | None = None) -> list[dict]:
+def outcome_rows(agent: str, records: list[dict], out, accounting: dict | None = None,
+                 prices: dict | None = None) -> list[dict]:
     """Rows of an outcome table from a rollout's :class:`~ignjax.sim.types.OutcomeRow`
     (numpy or JAX arrays with leading axis E matching ``records``) and, for
-    MLLM agents, the per-episode ``accounting`` (:data:`ACCOUNTING_COLUMNS` -> (E,))."""
+    MLLM agents, the per-episode ``accounting`` (:data:`ACCOUNTING_COLUMNS` -> (E,))
+    priced at ``prices`` (``[llm].prices``; None: ``cost_usd`` NaN)."""
+    if accounting:
+        from ignjax.agents.llm.client import price  # aiohttp only when asked
     o = {k: np.asarray(getattr(out, k)) for k in ("final_distance", "final_euclidean", "min_distance", "path_length",
                                                   "steps", "stopped", "stop_reason", "n_questions", "n_refused",
                                                   "n_invalid", "trace_type", "trace_step", "trace_charged")}
@@ -103,31 +117,57 @@ def outcome_rows(agent: str, records: list[dict], out, accounting: dict | None =
             "n_invalid": int(o["n_invalid"][k]),
             "trace": _trace(o["trace_type"][k], o["trace_step"][k], o["trace_charged"][k]),
             **{c: int(accounting[c][k]) if accounting else 0 for c in _ACCOUNTING_INTS},
+            "cost_usd": (_or_nan(price(int(accounting["prompt_tokens"][k]), int(accounting["completion_tokens"][k]),
+                                       prices)) if accounting else 0.0),
             "model_latency_s": float(accounting["model_latency_s"][k]) if accounting else 0.0,
             "failure": str(accounting["failure"][k]) if accounting else "",
         })
     return rows
 
 
+def _or_nan(v) -> float:
+    return float("nan") if v is None else float(v)
+
+
 def model_totals(rows: list[dict], prices: dict | None = None) -> dict[str, dict]:
-    """Per MLLM agent: the accounting columns of outcome ``rows`` summed over
-    its episodes, the episodes ended by model failure, and a cost estimate
-    from ``prices`` (``{"prompt": x, "completion": y}`` USD per million
-    tokens, as ``[llm].prices``; ``cost_usd`` None without prices)."""
+    """Per MLLM agent (an agent with a model call or a model failure in any
+    row): the accounting columns of outcome ``rows`` summed over its
+    episodes, the episodes ended by model failure, a cost estimate from
+    ``prices`` (``{"prompt": x, "completion": y}`` USD per million tokens,
+    as ``[llm].prices``; ``cost_usd`` None without prices), ``episodes``
+    and ``per_episode``: for each of :data:`PER_EPISODE`, ``{"mean": ...,
+    "max": ...}`` over all the agent's episodes (``cost_usd`` None without
+    prices)."""
     from ignjax.agents.llm.client import price  # aiohttp only when asked
 
-    out: dict[str, dict] = {}
+    by_agent: dict[str, list[dict]] = {}
     for r in rows:
-        if not (r["requests"] or r["cache_hits"] or r["failure"]):
+        by_agent.setdefault(r["agent"], []).append(r)
+    out: dict[str, dict] = {}
+    for agent, rs in by_agent.items():
+        if not any(r["requests"] or r["cache_hits"] or r["failure"] for r in rs):
             continue
-        t = out.setdefault(r["agent"], {"requests": 0, "cache_hits": 0, "prompt_tokens": 0, "completion_tokens": 0,
-                                        "retries": 0, "invalid_replies": 0, "failures": 0})
-        for k in ("requests", "cache_hits", "prompt_tokens", "completion_tokens", "retries", "invalid_replies"):
-            t[k] += int(r[k])
-        t["failures"] += int(bool(r["failure"]))
-    for t in out.values():
+        t = {k: sum(int(r.get(k, 0)) for r in rs) for k in _ACCOUNTING_INTS}
+        t["failures"] = sum(bool(r["failure"]) for r in rs)
         t["cost_usd"] = price(t["prompt_tokens"], t["completion_tokens"], prices)
+        t["episodes"] = len(rs)
+        each = {"calls": [int(r["requests"]) + int(r["cache_hits"]) for r in rs],
+                "prompt_tokens": [int(r["prompt_tokens"]) for r in rs],
+                "completion_tokens": [int(r["completion_tokens"]) for r in rs],
+                "cost_usd": [price(int(r["prompt_tokens"]), int(r["completion_tokens"]), prices) for r in rs]}
+        t["per_episode"] = {k: None if v[0] is None else {"mean": float(np.mean(v)), "max": max(v)}
+                            for k, v in each.items()}
+        out[agent] = t
     return out
+
+
+def per_episode_text(t: dict) -> str:
+    """One agent's :func:`model_totals` per-episode figures in words (``mean / max``)."""
+    pe = t["per_episode"]
+    cost = "" if pe["cost_usd"] is None else f", cost {pe['cost_usd']['mean']:.6f} / {pe['cost_usd']['max']:.6f} USD"
+    return (f"per episode (mean / max over {t['episodes']}): {pe['calls']['mean']:.1f} / {pe['calls']['max']} model "
+            f"calls, {pe['prompt_tokens']['mean']:.0f} / {pe['prompt_tokens']['max']} prompt tokens, "
+            f"{pe['completion_tokens']['mean']:.0f} / {pe['completion_tokens']['max']} completion tokens{cost}")
 
 
 def _arrow_table(rows: list[dict]):
@@ -137,8 +177,8 @@ def _arrow_table(rows: list[dict]):
                         ("stopped", pa.bool_()), ("stop_reason", pa.string()), ("q1", pa.int32()), ("q2", pa.int32()),
                         ("q3", pa.int32()), ("q4", pa.int32()), ("n_questions", pa.int32()), ("n_refused", pa.int32()),
                         ("n_invalid", pa.int32()), ("trace", pa.string()),
-                        *[(c, pa.int64()) for c in _ACCOUNTING_INTS], ("model_latency_s", pa.float64()),
-                        ("failure", pa.string())])
+                        *[(c, pa.int64()) for c in _ACCOUNTING_INTS], ("cost_usd", pa.float64()),
+                        ("model_latency_s", pa.float64()), ("failure", pa.string())])
     return pa.Table.from_pylist(rows, schema=schema)
 
 
@@ -185,21 +225,24 @@ def read_outcomes(path: str | os.PathLike) -> list[dict]:
                 for k in _ACCOUNTING_INTS:
                     if k in r:
                         r[k] = int(r[k])
-                if "model_latency_s" in r:
-                    r["model_latency_s"] = float(r["model_latency_s"])
+                for k in ("model_latency_s", "cost_usd"):
+                    if k in r:
+                        r[k] = float(r[k])
                 r["stopped"] = r["stopped"] in ("True", "true", "1")
             except (KeyError, ValueError) as e:
                 raise InputError(p, f"line {i + 2}", f"bad or missing value: {e}") from e
     else:
         raise InputError(p, None, "expected a .parquet or .csv outcome table")
     if rows:
-        missing = [c for c in COLUMNS if c not in rows[0] and c not in ACCOUNTING_COLUMNS]
+        missing = [c for c in COLUMNS if c not in rows[0] and c not in ACCOUNTING_COLUMNS + ("cost_usd",)]
         if missing:
             raise InputError(p, "columns", f"missing {missing}")
         for r in rows:
             for c in ACCOUNTING_COLUMNS:
                 if c not in r or r[c] is None:
                     r[c] = "" if c == "failure" else 0.0 if c == "model_latency_s" else 0
+            if r.get("cost_usd") is None:  # older tables: no model calls cost nothing, others are unknown
+                r["cost_usd"] = 0.0 if not (r["prompt_tokens"] or r["completion_tokens"]) else float("nan")
     return rows
 
 
@@ -360,5 +403,6 @@ def read_trajectories(path: str | os.PathLike) -> tuple[dict, dict[str, dict[str
     return meta, out
 
 
-__all__ = ["COLUMNS", "BIN_NAMES", "outcome_rows", "model_totals", "write_outcomes", "read_outcomes", "to_metric_outcomes", "metric_rows",
+__all__ = ["COLUMNS", "ACCOUNTING_COLUMNS", "PER_EPISODE", "BIN_NAMES", "outcome_rows", "model_totals",
+           "per_episode_text", "write_outcomes", "read_outcomes", "to_metric_outcomes", "metric_rows",
            "write_metric_table", "parse_trace", "TRAJECTORY_FILE", "write_trajectories", "read_trajectories"]

@@ -15,6 +15,12 @@ follow the paper's rules:
   (:func:`route_leaks` checks this).
 * Type 4 (confirmation) says yes or no with a short reason and, after a
   yes, whether to stop now or take one closer move first.
+
+Optionally (``llm.paraphrase``), a model rewords each answer before the
+agent reads it (:func:`paraphrase_messages`, :data:`PARAPHRASE_SCHEMA`;
+the host loop sends it). A rewording replaces the template only when
+:func:`paraphrase_leaks` finds nothing in it that the template's own rules
+forbid; otherwise the template is used.
 """
 
 from __future__ import annotations
@@ -22,6 +28,7 @@ from __future__ import annotations
 import re
 import zlib
 
+from ignjax.protocol import QUESTION_TYPES
 from ignjax.scenes import vocab
 from ignjax.sim import types as T
 
@@ -148,4 +155,95 @@ def route_leaks(text: str) -> list[str]:
     for name, pat in (("digit", _DIGIT), ("unit", _UNITS), ("compass", _COMPASS), ("coordinate", _COORD),
                       ("number word", _NUMBER_WORDS)):
         out += [f"{name}: {m.group(0)!r}" for m in pat.finditer(text)]
+    return out
+
+
+# ---------------------------------------------------------------------------
+# paraphrase by a model (llm.paraphrase)
+# ---------------------------------------------------------------------------
+
+PARAPHRASE_SCHEMA = {
+    "type": "object",
+    "properties": {"text": {"type": "string", "maxLength": 400}},
+    "required": ["text"],
+    "additionalProperties": False,
+}
+"""JSON schema of a paraphrase reply: ``{"text": "<the reworded answer>"}``."""
+
+PARAPHRASE_SYSTEM = (
+    "You reword the short answers a helper gives to a robot that is searching a house for one object. Say the "
+    "same thing in your own words, in one or two short sentences, speaking to the robot. Keep the meaning "
+    "exactly: add nothing (no new details, places or reasons), leave nothing out, keep a yes a yes and a no a no, "
+    "and use no numbers, distances, units or compass directions. "
+    'Reply with one JSON object and nothing else: {"text": "<the reworded answer>"}.'
+)
+"""The paraphrase request's system prompt (our wording)."""
+
+
+def paraphrase_messages(question: int, text: str) -> list[dict]:
+    """Chat messages asking a model to reword the oracle's answer ``text`` to a
+    question of type ``question`` (1..4) without adding information."""
+    kind = QUESTION_TYPES[int(question) - 1]
+    return [{"role": "system", "content": PARAPHRASE_SYSTEM},
+            {"role": "user", "content": f"The helper's answer to a {kind} question:\n{text}"}]
+
+
+def _words(words) -> re.Pattern:
+    alt = "|".join(sorted((re.escape(w) for w in words), key=len, reverse=True))
+    return re.compile(rf"\b({alt})(e?s)?\b", re.I)
+
+
+_ROOM_WORDS = _words(vocab.ROOM_DISPLAY[label] for label in vocab.ROOM_LABELS)
+_LOOK_WORDS = _words(tuple(vocab.COLORS) + ("grey",) + vocab.MATERIALS)
+_YES = re.compile(r"\byes\b", re.I)
+_NO = re.compile(r"\b(no|not|nope)\b|n[\'\u2019]t\b", re.I)
+_CLOSER = re.compile(r"\b(closer|nearer)\b", re.I)
+
+
+def paraphrase_leaks(question: int, text: str, template: str) -> list[str]:
+    """What in a model's rewording ``text`` of the oracle's answer
+    ``template`` (question type ``question``) breaks a rule the template
+    keeps; empty when the rewording may replace the template.
+
+    Simple word checks, each against the template's own rules:
+
+    * every type: an empty rewording;
+    * Type 1 (appearance; never places the target): a room name
+      (:data:`~ignjax.scenes.vocab.ROOM_LABELS`, plurals too) the template
+      does not contain;
+    * Type 2 (region; adds no appearance detail): a colour or material word
+      (:data:`~ignjax.scenes.vocab.COLORS`, ``MATERIALS``) the template does
+      not contain;
+    * Type 3 (route): :func:`route_leaks`, the template's own filter;
+    * Type 4 (confirmation): :func:`route_leaks` too (a confirmation gives no
+      distance) but for number words ("that is the one"), and the
+      answer kept: the template starts with "Yes" or
+      "No"; a yes needs the word "yes" and no negation (no, not, n't: a
+      rewording that negates anything is refused, erring on the side of the
+      template), a no needs a negation and no "yes"; a yes that says to move
+      closer keeps "closer" (or "nearer").
+    """
+    t = str(text or "").strip()
+    if not t:
+        return ["empty: the rewording is empty"]
+    q = int(question)
+    out: list[str] = []
+    if q == 1:
+        out += [f"room: {m.group(0)!r}" for m in _ROOM_WORDS.finditer(t)
+                if not re.search(rf"\b{re.escape(m.group(1))}", template, re.I)]
+    elif q == 2:
+        out += [f"appearance: {m.group(0)!r}" for m in _LOOK_WORDS.finditer(t)
+                if not re.search(rf"\b{re.escape(m.group(1))}", template, re.I)]
+    elif q == 3:
+        out += route_leaks(t)
+    elif q == 4:  # "that is the one": a pronoun in a confirmation, not a count
+        out += [x for x in route_leaks(t) if not x.startswith("number word")]
+    if q == 4:
+        yes = str(template).lstrip().lower().startswith("yes")
+        if yes and (not _YES.search(t) or _NO.search(t)):
+            out.append("answer: the rewording does not keep the yes")
+        if not yes and (not _NO.search(t) or _YES.search(t)):
+            out.append("answer: the rewording does not keep the no")
+        if yes and _CLOSER.search(template) and not _CLOSER.search(t):
+            out.append("follow-up: the rewording drops the closer move")
     return out

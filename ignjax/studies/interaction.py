@@ -58,6 +58,42 @@ Type-3 location (:func:`classify_locations`, :func:`type3_locations`)
     geometric class, a wide spot (``room``) becoming ``corridor``; a pose
     outside every room keeps its geometric class.
 
+Type-3 content (:func:`classify_question`, :func:`type3_content`)
+    What a Type-3 question asked, from its text (the paper's split: explicit
+    route requests, the spatial position of the goal room, relations
+    between rooms). Only agents that write their questions have texts
+    (TANDEM and the baselines built on it: the transcript's ``question``,
+    :func:`ignjax.evaluate.hostloop.question_texts`); for the others (the
+    JAX-native agents, ``vlm``) the split is not applicable and no count is
+    made. The classifier is a fixed list of patterns, tried on the
+    lower-cased text with runs of spaces made one, in this order; the first
+    class with a match wins:
+
+    1. ``route`` (how to travel): "which way", "what way", "how do/can/
+       should I get/go/reach/head", "how to get/go/reach", "path", "route",
+       "next turn", "which turn", "should I turn/go/head/take", "where
+       should/do/can I go/head/walk/turn", "direction(s) to", "way to",
+       "get to";
+    2. ``room_relations`` (rooms among themselves): "next to", "adjacent",
+       "connect..." (connects, connected, connection), "between", "beyond",
+       "neighbo(u)r...", "lead(s) to/into", "open(s) to/into/onto",
+       "relative to", "other side of", "across from", "from the <room>",
+       "behind/past/after the <room>" (<room>: a room label of
+       :data:`~ignjax.scenes.vocab.ROOM_LABELS`, or room, hall, corridor);
+    3. ``goal_room_position`` (where the goal room or target lies): "where
+       is/are/'s", "which/what room/part/side/area/wing/floor", "in which
+       room/part/area", "located", "location", "which direction is", "how
+       far", "is the/this/that/it <room>", "am I/are we in/near/close to/
+       far from", "goal room", "target room";
+    4. otherwise ``unclassified``.
+
+    So "Which way is the kitchen?" is a route request and "Where is the
+    kitchen relative to the hallway?" a relation. A question asked without
+    text (TANDEM's controller asks for a route hint on its own after
+    several moves without one) is counted apart (``n_without_text``), in
+    no class. Shares are over the three content classes (as the paper's
+    10/65/25 %).
+
 Questions per difficulty (:func:`questions_per_difficulty`)
     Mean |Q| and mean Q_t per difficulty bin over valid episodes.
 
@@ -93,6 +129,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -101,11 +138,15 @@ from scipy import ndimage
 from ignjax.errors import ConfigError, InputError
 from ignjax.evaluate.outcomes import parse_trace
 from ignjax.protocol import BIN_NAMES, TYPE_LABELS
+from ignjax.scenes.vocab import ROOM_DISPLAY, ROOM_LABELS
 from ignjax.studies._common import as_array, new_figure, save
 
 LOCATION_CLASSES: tuple[str, ...] = ("corridor", "junction", "dead_end", "room")
 CORRIDOR, JUNCTION, DEAD_END, ROOM = range(4)
 UNKNOWN = -1
+CONTENT_CLASSES: tuple[str, ...] = ("route", "goal_room_position", "room_relations", "unclassified")
+"""What a Type-3 question asked (module docstring, "Type-3 content")."""
+ROUTE_REQUEST, GOAL_ROOM_POSITION, ROOM_RELATIONS, UNCLASSIFIED = range(4)
 
 
 # ---------------------------------------------------------------------------
@@ -476,6 +517,81 @@ def type3_locations(grids, poses, events: dict, *, scene_index=None, room_labels
 
 
 # ---------------------------------------------------------------------------
+# Type-3 content
+# ---------------------------------------------------------------------------
+
+_ROOMS = "|".join(sorted({ROOM_DISPLAY[r] for r in ROOM_LABELS} | {"room", "hall", "corridor"}, key=len, reverse=True))
+_CONTENT_RULES = (
+    (ROUTE_REQUEST, re.compile(
+        r"\b(which|what) way\b|\bhow (do|can|should|would|could) (i|we) (get|go|reach|head|find)\b"
+        r"|\bhow to (get|go|reach)\b|\b(path|paths|route|routes)\b|\b(next|which) turn\b"
+        r"|\bshould (i|we) (turn|go|head|take)\b|\bwhere (should|do|can|must) (i|we) (go|head|walk|turn)\b"
+        r"|\bdirections? to\b|\bway to\b|\bget to\b")),
+    (ROOM_RELATIONS, re.compile(
+        r"\bnext to\b|\badjacent\b|\bconnect(s|ed|ing|ion|ions)?\b|\bbetween\b|\bbeyond\b"
+        r"|\bneighbou?r(s|ing|ed)?\b|\bleads? (in)?to\b|\bopens? (in|on)?to\b|\brelative to\b"
+        r"|\bother side of\b|\bacross from\b"
+        rf"|\bfrom the ({_ROOMS})s?\b|\b(behind|past|after) the ({_ROOMS})s?\b")),
+    (GOAL_ROOM_POSITION, re.compile(
+        r"\bwhere('s| is| are)\b|\b(which|what) (room|part|side|area|wing|floor)\b|\bin which (room|part|area)\b"
+        r"|\blocated\b|\blocation\b|\bwhich direction is\b|\bhow far\b"
+        rf"|\bis (the |this |that |it )?({_ROOMS})\b|\b(am i|are we) (in|near|close to|far from)\b"
+        r"|\b(goal|target) room\b")),
+)
+
+
+def classify_question(text: str) -> int:
+    """Content class of one Type-3 question's text: an index into
+    :data:`CONTENT_CLASSES` (the rules of the module docstring, "Type-3
+    content"; ``unclassified`` for text that no rule matches, empty text
+    included)."""
+    t = " ".join(str(text or "").lower().replace("\u2019", "'").split())
+    for cls, pattern in _CONTENT_RULES:
+        if pattern.search(t):
+            return cls
+    return UNCLASSIFIED
+
+
+def type3_content(events: dict, texts: dict | None, *, reason: str = "") -> dict:
+    """What every Type-3 question asked (module docstring, "Type-3 content").
+
+    Args:
+        events: question events (:func:`events_from_rows` / :func:`events_from_trajectory`).
+        texts: ``(episode index, step) -> question text`` of the agent's ASK
+            decisions (a question missing from it, or with "", was asked
+            without text); None: the agent writes no question texts, and the
+            split is not applicable.
+        reason: why it is not applicable (with ``texts`` None), for reports.
+
+    Returns:
+        dict with ``applicable``; if False only ``reason``, ``classes`` and
+        ``n`` (Type-3 questions); otherwise per-question ``episode``,
+        ``step``, ``text`` and ``cls`` (-1 without text), ``classes``
+        (:data:`CONTENT_CLASSES`), ``counts`` (4,) over the questions with
+        text, ``n_without_text``, ``n``, ``fractions`` (3,) of the three
+        content classes over the questions they hold (NaN if none) and
+        ``counts_by_difficulty`` (3, 4).
+    """
+    sel = events["type"] == 3
+    ep, st = events["episode"][sel], events["step"][sel]
+    if texts is None:
+        return {"applicable": False, "reason": reason or "the agent's questions carry no text",
+                "classes": CONTENT_CLASSES, "n": int(sel.sum())}
+    txt = [str(texts.get((int(e), int(s)), "") or "") for e, s in zip(ep, st)]
+    cls = np.asarray([classify_question(t) if t.strip() else UNKNOWN for t in txt], np.int64)
+    known = cls >= 0
+    counts = np.bincount(cls[known], minlength=4)
+    diff = np.asarray(events["difficulty"])[ep]
+    by_d = np.zeros((3, 4), np.int64)
+    kd = known & (diff >= 0)
+    np.add.at(by_d, (diff[kd], cls[kd]), 1)
+    n3 = counts[:3].sum()
+    return {"applicable": True, "episode": ep, "step": st, "text": txt, "cls": cls, "classes": CONTENT_CLASSES,
+            "counts": counts, "n_without_text": int((~known).sum()), "n": int(len(ep)),
+            "fractions": counts[:3] / n3 if n3 else np.full(3, np.nan), "counts_by_difficulty": by_d}
+
+
+# ---------------------------------------------------------------------------
 # Questions per difficulty
 # ---------------------------------------------------------------------------
 
@@ -613,9 +729,14 @@ def plot_question_timing(result: dict, path: str | os.PathLike, title: str | Non
     return save(fig, path)
 
 
-def plot_location_classes(result: dict, path: str | os.PathLike, title: str | None = None):
-    """Share of Type-3 questions per location class. ``result``: :func:`type3_locations`."""
-    fig, axs = new_figure(1, 1, size=(5.5, 4.0))
+def plot_location_classes(result: dict, path: str | os.PathLike, title: str | None = None, content: dict | None = None):
+    """Share of Type-3 questions per location class (``result``:
+    :func:`type3_locations`) and, with ``content`` (:func:`type3_content`), a
+    second panel with the share per content class (or why it is not
+    applicable)."""
+    fig, axs = new_figure(1, 1 if content is None else 2, size=(5.5 if content is None else 11.0, 4.0))
+    if content is not None:
+        _plot_content(axs[0, 1], content)
     ax = axs[0, 0]
     x = np.arange(4)
     frac = np.nan_to_num(result["fractions"])
@@ -629,6 +750,26 @@ def plot_location_classes(result: dict, path: str | os.PathLike, title: str | No
     ax.set_ylim(0, 105)
     ax.set_title(title or f"Where Type-3 questions arise ({result['n_unknown']} unclassified)", fontsize=10)
     return save(fig, path)
+
+
+def _plot_content(ax, content: dict) -> None:
+    if not content["applicable"]:
+        ax.text(0.5, 0.5, f"content split not applicable:\n{content['reason']}", ha="center", va="center",
+                fontsize=8, wrap=True, transform=ax.transAxes)
+        ax.set_axis_off()
+        return
+    x = np.arange(3)
+    frac = np.nan_to_num(content["fractions"])
+    ax.bar(x, 100 * frac, color=["#c44e52", "#4c72b0", "#8172b2"])
+    for i in x:
+        ax.text(i, 100 * frac[i] + 1, f"n={int(content['counts'][i])}", ha="center", fontsize=8)
+    ax.set_xticks(x)
+    ax.set_xticklabels(["route request", "goal-room position", "room relations"])
+    ax.set_xlabel("what the question asked (from its text)")
+    ax.set_ylabel("share of classified Type-3 questions (%)")
+    ax.set_ylim(0, 105)
+    ax.set_title(f"What Type-3 questions asked ({int(content['counts'][UNCLASSIFIED])} unclassified, "
+                 f"{content['n_without_text']} without text)", fontsize=10)
 
 
 def plot_questions_per_difficulty(result: dict, path: str | os.PathLike, title: str | None = None):
@@ -671,7 +812,8 @@ def plot_delta_u(result: dict, path: str | os.PathLike, title: str | None = None
     return save(fig, path)
 
 
-__all__ = ["LOCATION_CLASSES", "UNKNOWN", "LocationParams", "layout_mask", "events_from_rows", "events_from_trajectory",
-           "counts_from_events", "question_timing", "classify_locations", "type3_locations",
+__all__ = ["CONTENT_CLASSES", "LOCATION_CLASSES", "UNKNOWN", "LocationParams", "layout_mask", "events_from_rows",
+           "events_from_trajectory", "counts_from_events", "question_timing", "classify_locations", "type3_locations",
+           "classify_question", "type3_content",
            "questions_per_difficulty", "explored_area", "delta_u", "plot_question_timing", "plot_location_classes",
            "plot_questions_per_difficulty", "plot_delta_u"]

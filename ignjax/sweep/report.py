@@ -17,6 +17,7 @@ from types import MappingProxyType, SimpleNamespace
 import matplotlib.pyplot as plt
 import numpy as np
 
+from ignjax.agents.llm.catalog import LLM_AGENTS, get_llm_agent
 from ignjax.config import SweepConfig
 from ignjax.evaluate import metrics as M
 from ignjax.evaluate.outcomes import (metric_rows, model_totals, outcome_rows, write_metric_table, write_outcomes,
@@ -89,7 +90,7 @@ def study_eval(es, rollouts: dict, cfg: SweepConfig, out: Path) -> dict:
     for name, tree in rollouts.items():
         if name not in cfg.eval.agents:
             continue
-        rows += outcome_rows(name, es.records, SimpleNamespace(**tree["out"]), tree.get("accounting"))
+        rows += outcome_rows(name, es.records, SimpleNamespace(**tree["out"]), tree.get("accounting"), cfg.llm.prices)
         trajectories[name] = tree["traj"]
     write_outcomes(rows, out)
     metrics = metric_rows(rows, tuple(cfg.eval.thresholds), tuple(cfg.eval.costs), cfg.eval.require_stop)
@@ -233,6 +234,21 @@ def study_derive_costs(cfg: SweepConfig, out: Path) -> dict:
     return {"source": source, "table": (header, rows), "assumed": list(getattr(stats, "assumed", []) or [])}
 
 
+def question_content(es, agent: str, tree: dict, events: dict) -> dict:
+    """:func:`ignjax.studies.interaction.type3_content` of the analysed agent:
+    from the question texts its MLLM rollout keeps (``tree["questions"]``),
+    or not applicable, with the reason, for an agent that writes none."""
+    if agent not in LLM_AGENTS:
+        return IA.type3_content(events, None, reason=f"`{agent}` is a JAX-native agent: it asks by type code, "
+                                                     "without question text")
+    if not get_llm_agent(agent).writes_questions:
+        return IA.type3_content(events, None, reason=f"`{agent}` names the question type only; its decisions "
+                                                     "carry no question text")
+    index = {eid: i for i, eid in enumerate(es.episode_ids)}
+    texts = {(index[q["episode"]], q["step"]): q["text"] for q in tree.get("questions", ())}
+    return IA.type3_content(events, texts)
+
+
 def study_analysis(es, rollouts: dict, cfg: SweepConfig, out: Path) -> dict:
     agent = cfg.analysis.agent
     tree = rollouts[agent]
@@ -246,9 +262,10 @@ def study_analysis(es, rollouts: dict, cfg: SweepConfig, out: Path) -> dict:
     loc = IA.type3_locations(grids, np.asarray(traj.pose), events, scene_index=scene_index, room_labels=labels)
     qpd = IA.questions_per_difficulty(np.asarray(tree["out"]["n_questions"]), diff)
     du = IA.delta_u(np.asarray(traj.pose), events, h=int(cfg.analysis.horizon), r=float(cfg.analysis.radius))
+    content = question_content(es, agent, tree, events)
     fig = out / "figures"
     IA.plot_question_timing(timing, fig / "analysis_timing.png")
-    IA.plot_location_classes(loc, fig / "analysis_type3_locations.png")
+    IA.plot_location_classes(loc, fig / "analysis_type3_locations.png", content=content)
     IA.plot_questions_per_difficulty(qpd, fig / "analysis_questions_per_difficulty.png")
     IA.plot_delta_u(du, fig / "analysis_delta_u.png")
     rows = [[BIN_NAMES[b], float(qpd["mean_total"][b])] + [float(qpd["mean_per_type"][b, t]) for t in range(4)]
@@ -259,9 +276,19 @@ def study_analysis(es, rollouts: dict, cfg: SweepConfig, out: Path) -> dict:
     lheader = ["class", "Type-3 questions", "share"]
     lrows = [[c, int(n), float(f)] for c, n, f in zip(loc["classes"], loc["counts"], loc["fractions"])]
     write_csv(out / "analysis_type3_locations.csv", lheader, lrows)
+    ctable = None
+    if content["applicable"]:
+        n = content["n"]
+        cheader = ["content", "Type-3 questions", "share of classified", "share of all"]
+        nan = float("nan")
+        crows = [[c, int(k), float(content["fractions"][i]) if i < 3 else nan, k / n if n else nan]
+                 for i, (c, k) in enumerate(zip(content["classes"], content["counts"]))]
+        crows.append(["no text", content["n_without_text"], nan, content["n_without_text"] / n if n else nan])
+        write_csv(out / "analysis_type3_content.csv", cheader, crows)
+        ctable = (cheader, crows)
     plots = plot_trajectories(es, tree, int(cfg.analysis.trajectories), fig, agent)
     return {"agent": agent, "per_difficulty": (header, rows), "locations": (lheader, lrows), "timing": timing,
-            "trajectory_plots": plots}
+            "content": content, "content_table": ctable, "trajectory_plots": plots}
 
 
 QUESTION_STYLE = {1: ("o", "tab:purple"), 2: ("s", "tab:orange"), 3: ("^", "tab:red"), 4: ("D", "tab:green")}
@@ -344,7 +371,23 @@ def _section_eval(results: dict, es, rollouts: dict, cfg, out: Path) -> list[str
             cost = "" if t["cost_usd"] is None else f"{t['cost_usd']:.4f}"
             parts.append(f"| {name} | {t['requests']} | {t['cache_hits']} | {t['prompt_tokens']} | "
                          f"{t['completion_tokens']} | {t['retries']} | {t['invalid_replies']} | {t['failures']} | {cost} |")
+        parts += ["", "Per episode (mean / max over the agent's episodes; model calls sent or answered from the cache, "
+                  "whose tokens and cost count alike; per-episode figures also in the outcome table's `requests`, "
+                  "`cache_hits`, `prompt_tokens`, `completion_tokens` and `cost_usd` columns):", "",
+                  "| agent | episodes | model calls | prompt tokens | completion tokens | cost (USD) |",
+                  "|---|---|---|---|---|---|"]
+        for name, t in ev["model_totals"].items():
+            pe = t["per_episode"]
+            cost = "" if pe["cost_usd"] is None else f"{pe['cost_usd']['mean']:.6f} / {pe['cost_usd']['max']:.6f}"
+            parts.append(f"| {name} | {t['episodes']} | {pe['calls']['mean']:.1f} / {pe['calls']['max']} | "
+                         f"{pe['prompt_tokens']['mean']:.0f} / {pe['prompt_tokens']['max']} | "
+                         f"{pe['completion_tokens']['mean']:.0f} / {pe['completion_tokens']['max']} | {cost} |")
         parts.append("")
+        if cfg.llm.paraphrase:
+            parts += ["Oracle answers were reworded by the model before the agents read them (`llm.paraphrase`; "
+                      "transcript role `paraphrase`); rewordings refused by the leak checks, the template shown "
+                      "instead: " + ", ".join(f"{name} {t['paraphrase_rejected']}"
+                                             for name, t in ev["model_totals"].items()) + ".", ""]
     return parts
 
 
@@ -410,11 +453,21 @@ def _section_analysis(results: dict, es, rollouts: dict, cfg, out: Path) -> list
     parts = [f"## Interaction analyses (`{an['agent']}`)", "",
              M.md_table(*an["per_difficulty"]), "",
              "Where Type-3 questions were asked (classified from the navigation grid):", "",
-             M.md_table(*an["locations"]), "",
-             "![Timing](figures/analysis_timing.png)", "",
-             "![Type-3 locations](figures/analysis_type3_locations.png)", "",
-             "![Questions per difficulty](figures/analysis_questions_per_difficulty.png)", "",
-             "![Delta-U](figures/analysis_delta_u.png)", ""]
+             M.md_table(*an["locations"]), ""]
+    if an["content_table"] is not None:
+        h, rows = an["content_table"]
+        parts += ["What Type-3 questions asked, classified from the question text the agent wrote (rules in "
+                  "`ignjax.studies.interaction`; shares of classified in the paper: route 10%, goal-room position "
+                  "65%, room relations 25%), in `analysis_type3_content.csv`:", "",
+                  M.md_table(h, [[r[0], r[1]] + [f"{100 * v:.1f}%" if math.isfinite(v) else "" for v in r[2:]]
+                                 for r in rows]), ""]
+    else:
+        parts += [f"What Type-3 questions asked (route / goal-room position / room relations): not applicable, "
+                  f"{an['content']['reason']}.", ""]
+    parts += ["![Timing](figures/analysis_timing.png)", "",
+              "![Type-3 locations and content](figures/analysis_type3_locations.png)", "",
+              "![Questions per difficulty](figures/analysis_questions_per_difficulty.png)", "",
+              "![Delta-U](figures/analysis_delta_u.png)", ""]
     for p in an["trajectory_plots"]:
         parts += [f"![trajectory]({p.relative_to(out).as_posix()})", ""]
     return parts
@@ -465,5 +518,6 @@ def write_outputs(results: dict, out: Path) -> None:
     atomic_write(out / "report.md", "\n".join(parts))
 
 
-__all__ = ["SECTIONS", "VIEWER_FILE", "settings_lines", "agent_arrays", "factors_of", "in_loop_costs", "plot_trajectories", "study_analysis", "study_costs",
+__all__ = ["SECTIONS", "VIEWER_FILE", "settings_lines", "agent_arrays", "factors_of", "in_loop_costs",
+           "plot_trajectories", "question_content", "study_analysis", "study_costs",
            "study_derive_costs", "study_difficulty", "study_eval", "write_csv", "write_outputs"]

@@ -10,7 +10,9 @@ flight, the charged ``eval.costs`` shown to it and ``run.seed``. Its
 checkpoint is the host loop's own (``<run>/llm/<agent>.progress.jsonl``,
 one line per finished episode), so ``--resume`` after a kill continues
 episode by episode; replies are cached in ``llm.cache_dir`` (default
-``<run>/llm_cache``), and transcripts go to ``<run>/transcripts/<agent>.jsonl``."""
+``<run>/llm_cache``), and transcripts go to ``<run>/transcripts/<agent>.jsonl``;
+the question texts the agent wrote (:func:`ignjax.evaluate.hostloop.question_texts`)
+stay with its rollout for the analysis study."""
 
 from __future__ import annotations
 
@@ -121,7 +123,7 @@ def run_eval_stage(es, world, agent_name: str, cfg: SweepConfig, ckpt: Checkpoin
 
 def run_llm_stage(es, agent_name: str, cfg: SweepConfig, out: Path, bar=None, quiet: bool = False) -> dict:
     """Outcomes, trajectories and model-call accounting of one MLLM agent (module docstring)."""
-    from ignjax.evaluate.hostloop import run_llm_agent, write_transcripts  # aiohttp, renderers: only when asked
+    from ignjax.evaluate.hostloop import question_texts, run_llm_agent, write_transcripts  # aiohttp, renderers
 
     llm = cfg.llm
     if llm.cache_dir is None:
@@ -133,7 +135,8 @@ def run_llm_stage(es, agent_name: str, cfg: SweepConfig, out: Path, bar=None, qu
         bar.update(len(es))
     acc = {k: np.asarray(v) for k, v in res.accounting.items() if k != "failure"}
     return {"out": _to_tree(res.outcomes), "traj": _to_tree(res.trajectories),
-            "accounting": {**acc, "failure": list(res.accounting["failure"])}, "stats": res.stats}
+            "accounting": {**acc, "failure": list(res.accounting["failure"])}, "stats": res.stats,
+            "questions": question_texts(res.transcripts)}
 
 
 def run_costs_stage(es, world, cfg: SweepConfig, ckpt: Checkpoints, bar=None) -> dict:

@@ -55,7 +55,9 @@ Written by agents that see images or call models (optional; shown when present):
 ``transcripts.jsonl`` and ``transcripts/*.jsonl``
     one JSON object per line, one line per model call, with the keys
     ``agent`` (str), ``episode`` (the episode id), ``step`` (int, 0-based
-    planner step), ``role`` (``"planner"`` or ``"grounder"``), ``prompt``
+    planner step), ``role`` (``"planner"``, ``"grounder"``, ``"controller"``:
+    a decision taken without a model call, or ``"paraphrase"``: an oracle
+    answer reworded by the model), ``prompt``
     (str, the text sent), ``reply`` (str, the raw reply), ``parsed`` (any
     JSON value: the parse result, null when parsing failed), ``retries``
     (int, or a list of ``{"reply": str, "error": str}`` earlier attempts)

@@ -35,7 +35,9 @@ IMAGE_NAME = re.compile(r"^(\d+)_(panel|grounder)\.(jpg|jpeg|png)$", re.IGNORECA
 """``<step>_<kind>.<ext>`` of an image file (see the module docstring of :mod:`ignjax.view`)."""
 IMAGE_KINDS = ("panel", "grounder")
 TRANSCRIPT_KEYS = ("agent", "episode", "step", "role", "prompt", "reply", "parsed", "retries", "error")
-ROLES = ("planner", "grounder")
+ROLES = ("planner", "grounder", "controller", "paraphrase")
+"""Transcript roles: a Planner or Grounder call, a decision the agent's controller took without a model call, a
+rewording of an oracle answer (``llm.paraphrase``)."""
 
 
 @dataclass

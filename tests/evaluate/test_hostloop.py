@@ -24,6 +24,7 @@ from ignjax.agents.llm.config import LLMConfig
 from ignjax.agents.llm.serve import ScriptedServer
 from ignjax.episodes.dataset import load_benchmark
 from ignjax.evaluate.hostloop import run_llm_agent
+from ignjax.evaluate.outcomes import read_outcomes
 from ignjax.sim import types as T
 from ignjax.sim.views import ViewConfig
 from ignjax.sim.views.config import egl_available, warp_available
@@ -204,3 +205,13 @@ def test_resume_after_sigkill(tmp_path, monkeypatch):
         assert srv.stats()["requests"] == before and "0 requests sent" in again.stderr
         run = json.loads((out / "run.json").read_text())
         assert run["model_totals"]["vlm"]["requests"] + run["model_totals"]["vlm"]["cache_hits"] > 0
+        # the printed summary's per-episode figures are those of the outcome rows (calls answered from the cache
+        # count: their tokens do); no prices given, so no cost
+        rows = read_outcomes(out / "outcomes.csv")
+        calls, pt, ct = ([r[k] + (r["cache_hits"] if k == "requests" else 0) for r in rows]
+                         for k in ("requests", "prompt_tokens", "completion_tokens"))
+        assert (f"vlm: per episode (mean / max over 3): {np.mean(calls):.1f} / {max(calls)} model calls, "
+                f"{np.mean(pt):.0f} / {max(pt)} prompt tokens, {np.mean(ct):.0f} / {max(ct)} completion tokens\n"
+                in again.stdout), again.stdout
+        assert run["model_totals"]["vlm"]["per_episode"]["calls"]["max"] == max(calls)
+        assert all(np.isnan(r["cost_usd"]) for r in rows)

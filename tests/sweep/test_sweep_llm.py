@@ -2,19 +2,24 @@
 ``eval.agents`` naming ``vlm`` beside a JAX-native agent, the model server
 given in the ``[llm]`` table (the scripted server on 127.0.0.1: a test double
 whose replies are computed from the request text) and the observations in
-``[views]``. Checks the outcome tables' accounting columns, the report's
-model-call table, transcripts, a second run answered from the shared cache
-with zero requests and identical outcomes, and the configuration errors."""
+``[views]``. Checks the outcome tables' accounting and cost columns, the
+report's model-call tables (totals and per episode), transcripts, the
+interaction analyses on an MLLM agent's traces (``tandem-naive``, whose
+Planner replies a policy scripts: Type-3 questions with texts of each
+content class), a second run answered from the shared cache with zero
+requests and identical outcomes, and the configuration errors."""
 
 from __future__ import annotations
 
 import csv
 import json
+import re
 from pathlib import Path
 
 import pytest
 
-from ignjax.agents.llm.serve import ScriptedServer
+from ignjax.agents.llm.serve import ScriptedServer, scripted_reply
+from ignjax.studies.interaction import CONTENT_CLASSES, classify_question
 from ignjax.config import fingerprint, resolve
 from ignjax.errors import ConfigError
 from ignjax.sim.views.config import egl_available, warp_available
@@ -32,7 +37,29 @@ def _sets(srv, root: Path, cache: Path) -> list[str]:
             "eval.agents=['random', 'vlm']", "eval.batch=3", "sim.max_steps=6", "views.size=64",
             f"llm.endpoints=['{srv.base_url}']", f"llm.model='{srv.model}'", "llm.api_key_env=''",
             f"llm.cache_dir='{cache}'", "llm.timeout_s=10.0", "llm.prices={prompt = 0.5, completion = 2.0}",
-            "analysis.agent='vlm'", "analysis.trajectories=1"]
+            "analysis.agent='tandem-naive'", "analysis.trajectories=1"]
+
+
+TYPE3_SCRIPT = {1: "Which way should I go to find the kitchen?", 2: "Where is the bedroom from here?",
+                3: "Which room is next to the hallway?", 4: "Can you help me?"}
+"""The analysed agent's Type-3 questions by turn (route, goal-room position, room relations, unclassified);
+it moves on the later turns."""
+
+
+def _policy(req: dict) -> str:
+    """``tandem-naive``'s Planner follows :data:`TYPE3_SCRIPT`; every other request (the vlm agent, the
+    Grounder) gets the server's default reply, a schema-valid instance."""
+    if req["response_format"]["json_schema"]["name"] != "planner_decision":
+        return scripted_reply(req)
+    text = "\n".join(p.get("text", "") for m in req["messages"] for p in
+                     ([{"text": m["content"]}] if isinstance(m["content"], str) else m["content"]))
+    turn = int(re.search(r"Turn (\d+) of", text).group(1))
+    ask = turn in TYPE3_SCRIPT
+    return json.dumps({"reasoning": "", "task_phase": "explore", "action": "ask" if ask else "move",
+                       "direction": "front", "subgoal": "the open doorway", "purpose": "look", "question_type": 3,
+                       "question": TYPE3_SCRIPT.get(turn, ""),
+                       "belief_update": {"current_room": "hall", "target_description": "", "visited_areas": [],
+                                         "unexplored_areas": [], "key_observations": []}})
 
 
 def _rows(path: Path) -> list[dict]:
@@ -42,7 +69,7 @@ def _rows(path: Path) -> list[dict]:
 
 @pytest.mark.skipif(warp_available() is not None and egl_available() is not None, reason="no rendering backend")
 def test_sweep_eval_runs_an_mllm_agent_and_reruns_from_the_cache(tmp_path, capsys):
-    with ScriptedServer() as srv:
+    with ScriptedServer(policy=_policy) as srv:
         sets = _sets(srv, tmp_path, tmp_path / "cache")
         argv = ["--study", "eval,analysis", "--quiet", "--out", str(tmp_path / "a")] + sum((["--set", s] for s in sets), [])
         assert main(argv) == 0, capsys.readouterr().err
@@ -52,22 +79,45 @@ def test_sweep_eval_runs_an_mllm_agent_and_reruns_from_the_cache(tmp_path, capsy
         vlm = [r for r in a if r["agent"] == "vlm"]
         rnd = [r for r in a if r["agent"] == "random"]
         assert len(vlm) == len(rnd) == 3
-        # one request per decision (no faults, no bad replies from the scripted policy), none for the JAX agent
-        assert sum(int(r["requests"]) for r in vlm) == sent == sum(int(r["steps"]) for r in vlm)
+        tandem = [json.loads(x) for x in (tmp_path / "a" / "transcripts" / "tandem-naive.jsonl").read_text().split("\n")
+                  if x]
+        # one request per decision (no faults, no bad replies from the scripted policy; tandem-naive's controller
+        # takes no decision on its own, so each of its transcript records is one request), none for the JAX agent
+        n_vlm = sent - len(tandem)
+        assert sum(int(r["requests"]) for r in vlm) == n_vlm == sum(int(r["steps"]) for r in vlm)
         assert all(int(r["prompt_tokens"]) > 0 and r["failure"] == "" for r in vlm)
         assert all(int(r["requests"]) == 0 and int(r["prompt_tokens"]) == 0 for r in rnd)
         # transcripts: one record per decision, naming the request's hash
         lines = (tmp_path / "a" / "transcripts" / "vlm.jsonl").read_text().splitlines()
-        assert len(lines) == sent and all(len(json.loads(x)["request_hash"]) == 64 for x in lines)
+        assert len(lines) == n_vlm and all(len(json.loads(x)["request_hash"]) == 64 for x in lines)
         # the report has the Table-1 rows for both agents and the model-call totals with the cost estimate
         report = (tmp_path / "a" / "report.md").read_text()
         assert "| vlm |" in report and "| random |" in report
         tokens = [sum(int(r[k]) for r in vlm) for k in ("prompt_tokens", "completion_tokens")]
         cost = (tokens[0] * 0.5 + tokens[1] * 2.0) / 1e6
-        assert f"| vlm | {sent} | 0 | {tokens[0]} | {tokens[1]} | 0 | 0 | 0 | {cost:.4f} |" in report
-        # the agent's options are stated in the report header; the interaction analyses ran on its traces
-        assert "- Agent `vlm`: observation=panel" in report
-        assert (tmp_path / "a" / "analysis_per_difficulty.csv").is_file() and "vlm" in report.split("## Interaction")[-1]
+        assert f"| vlm | {n_vlm} | 0 | {tokens[0]} | {tokens[1]} | 0 | 0 | 0 | {cost:.4f} |" in report
+        # per episode: the outcome rows' cost column and the report's mean / max, both from the rows' tokens
+        each = [(int(r["requests"]) + int(r["cache_hits"]), int(r["prompt_tokens"]), int(r["completion_tokens"]))
+                for r in vlm]
+        costs = [(p * 0.5 + c * 2.0) / 1e6 for _, p, c in each]
+        assert [float(r["cost_usd"]) for r in vlm] == pytest.approx(costs)
+        assert all(float(r["cost_usd"]) == 0.0 for r in rnd)
+        mean = [sum(x[k] for x in each) / 3 for k in range(3)]
+        assert (f"| vlm | 3 | {mean[0]:.1f} / {max(x[0] for x in each)} | {mean[1]:.0f} / {max(x[1] for x in each)} | "
+                f"{mean[2]:.0f} / {max(x[2] for x in each)} | {sum(costs) / 3:.6f} / {max(costs):.6f} |") in report
+        # the agents' options are stated in the report header; the interaction analyses ran on the MLLM agent's traces
+        assert "- Agent `vlm`: observation=panel" in report and "- Agent `tandem-naive`:" in report
+        section = report.split("## Interaction")[-1]
+        assert (tmp_path / "a" / "analysis_per_difficulty.csv").is_file() and "tandem-naive" in section
+        # what its Type-3 questions asked, classified from the texts in its transcript: one of each class per episode
+        asked = [c["question"] for c in tandem if c["action"] and c["action"][0] == 1 and c["action"][4] == 3]
+        expect = [sum(CONTENT_CLASSES[classify_question(q)] == k for q in asked) for k in CONTENT_CLASSES]
+        assert expect == [3, 3, 3, 3]
+        content = _rows(tmp_path / "a" / "analysis_type3_content.csv")
+        assert [(r["content"], int(r["Type-3 questions"])) for r in content] == list(zip(CONTENT_CLASSES, expect)) + [
+            ("no text", 0)]
+        assert [float(r["share of classified"]) for r in content[:3]] == pytest.approx([1 / 3] * 3)
+        assert "| route | 3 | 33.3% | 25.0% |" in section and "| room_relations | 3 | 33.3% | 25.0% |" in section
 
         # a second run (another folder, same cache) sends nothing and gives the same outcomes
         argv_b = ["--study", "eval", "--quiet", "--out", str(tmp_path / "b")] + sum((["--set", s] for s in sets), [])
@@ -75,8 +125,19 @@ def test_sweep_eval_runs_an_mllm_agent_and_reruns_from_the_cache(tmp_path, capsy
         assert srv.stats()["requests"] == sent
         b = _rows(tmp_path / "b" / "outcomes.csv")
         assert [[r[k] for k in OUTCOME_FIELDS] for r in b] == [[r[k] for k in OUTCOME_FIELDS] for r in a]
-        assert sum(int(r["cache_hits"]) for r in b if r["agent"] == "vlm") == sent
+        assert sum(int(r["cache_hits"]) for r in b if r["agent"] == "vlm") == n_vlm
         assert sum(int(r["requests"]) for r in b) == 0
+        # the cost columns count the cached calls' tokens alike
+        assert [r["cost_usd"] for r in b] == [r["cost_usd"] for r in a]
+        # an analysis of the vlm agent, whose decisions name the question type only: the split is not applicable
+        sets_c = [s for s in sets if not s.startswith("analysis.agent")] + ["analysis.agent='vlm'"]
+        argv_c = ["--study", "analysis", "--quiet", "--out", str(tmp_path / "c")]
+        argv_c += sum((["--set", s] for s in sets_c), [])
+        assert main(argv_c) == 0, capsys.readouterr().err
+        assert srv.stats()["requests"] == sent
+        report_c = (tmp_path / "c" / "report.md").read_text()
+        assert "not applicable, `vlm` names the question type only" in report_c
+        assert not (tmp_path / "c" / "analysis_type3_content.csv").exists()
 
 
 def test_mllm_agent_without_a_server_and_other_llm_config_errors(tmp_path):

@@ -138,6 +138,10 @@ class LLMAgent:
         show_costs: the prompt lists the question costs (the cost-aware setting).
         may_ask: the agent may ask questions at all.
         uses_views: decisions carry the rendered views (:attr:`Decision.views`).
+        writes_questions: an ASK decision carries the question's text, written
+            by the model (``decide`` hands it to ``ctx.note_question``); False:
+            the agent names the question type only (the oracle answers by type
+            either way).
     """
 
     name = "llm"
@@ -147,6 +151,7 @@ class LLMAgent:
     show_costs = True
     may_ask = True
     uses_views = False
+    writes_questions = False
 
     def start(self, episode: str) -> EpisodeMemory:
         return EpisodeMemory()

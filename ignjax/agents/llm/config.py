@@ -77,6 +77,13 @@ class LLMConfig:
             (``None``: no cache).
         replay: answer only from the cache, never send; a miss is an error.
             Needs ``cache_dir`` (or a cache given to the client).
+        paraphrase: send each oracle answer the agent reads through the
+            model for a rewording first (same endpoints, cache and
+            accounting; transcript role ``paraphrase``); a rewording that
+            breaks the template's rules
+            (:func:`ignjax.sim.oracle_text.paraphrase_leaks`) is dropped for
+            the template and counted in ``paraphrase_rejected``. Changes
+            results, so it is part of a run's fingerprint.
         prices: USD per 1M tokens, ``{"prompt": x, "completion": y}``.
         extra_body: extra keys merged into each request's JSON (for example
             vLLM's ``guided_decoding_backend``); may not set the keys the
@@ -101,6 +108,7 @@ class LLMConfig:
     image_detail: str | None = None
     cache_dir: str | None = None
     replay: bool = False
+    paraphrase: bool = False
     prices: dict | None = None
     extra_body: dict | None = None
 
@@ -209,8 +217,9 @@ def _validate(obj: LLMConfig, where: str, path: str | None) -> None:
                   f"http://127.0.0.1:8000/v1, got {e!r}")
     if len(set(eps)) != len(eps):
         _fail(path, where, "endpoints", "lists the same URL twice")
-    if not isinstance(obj.replay, bool):
-        _fail(path, where, "replay", f"expected true or false, got {obj.replay!r}")
+    for name in ("replay", "paraphrase"):
+        if not isinstance(getattr(obj, name), bool):
+            _fail(path, where, name, f"expected true or false, got {getattr(obj, name)!r}")
     object.__setattr__(obj, "endpoints", eps)
 
     if not isinstance(obj.model, str):

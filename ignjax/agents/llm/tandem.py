@@ -18,7 +18,10 @@ One decision of :class:`Tandem`:
    replies with one JSON decision (:func:`planner_schema`): ask (type and
    question), move (direction, a place-based subgoal, purpose) or stop
    (with its evidence), plus a belief update that the controller merges into
-   Spatial Memory.
+   Spatial Memory. The oracle answers a question by its type; the
+   question's text goes to the decision's transcript record
+   (``ctx.note_question``; none when the controller asks on its own), where
+   the Type-3 content analysis reads it.
 3. **Controller checks** on the Planner's decision; a decision that breaks
    a rule is answered with a correction and asked again (counted as an
    invalid reply, like a malformed one): a Type-1/2 question whose fact is
@@ -216,6 +219,11 @@ class Tandem(LLMAgent):
         self.memory_style, self.observation, self.n_views, self.reasks = memory_style, observation, n_views, int(reasks)
         self.may_ask = self.qa
         self.uses_views = self.two_stage and observation == "panel"
+
+    @property
+    def writes_questions(self) -> bool:
+        """The Planner writes each question's text (field ``question``) whenever it may ask."""
+        return self.qa
 
     @property
     def sim_overrides(self) -> dict:
@@ -481,6 +489,7 @@ class Tandem(LLMAgent):
     # -- one decision ------------------------------------------------------
     async def decide(self, ctx, m: TandemMemory, d: Decision):
         self._observe_outcome(m, d)
+        question = ""  # the Planner's question text; none when the controller asks (recovery, confirm before stop)
         act = self._controller(m, d)
         if act is None:
             plan = await ctx.query(self.planner_request(m, d), lambda parsed, err: self._parse_plan(m, d, parsed, err))
@@ -492,7 +501,11 @@ class Tandem(LLMAgent):
                 self._merge(m, d, parsed)
                 if act[0] == MOVE:
                     act = await self._ground(ctx, m, d, act, parsed)
-        self._record(m, d, act)
+                elif act[0] == ASK and parsed.get("action") == "ask":  # not a stop turned into a confirmation
+                    question = _clip(parsed.get("question"))
+        self._record(m, d, act, question)
+        if act[0] == ASK and question:
+            ctx.note_question(question)
         return act
 
     def _parse_plan(self, m: TandemMemory, d: Decision, parsed, err):
@@ -517,7 +530,7 @@ class Tandem(LLMAgent):
         col, row = got if got is not None else GROUNDER_FALLBACK
         return (MOVE, k, col, row, 1)
 
-    def _record(self, m: TandemMemory, d: Decision, act) -> None:
+    def _record(self, m: TandemMemory, d: Decision, act, question: str = "") -> None:
         names = view_names(d.n_views)
         kind = {MOVE: "move", ASK: "ask", STOP: "stop"}[act[0]]
         if not m.history or m.history[-1][0] != d.step:
@@ -526,7 +539,7 @@ class Tandem(LLMAgent):
             m.moves.append((d.step, names[act[1]], m.last_purpose and _clip(m.last_purpose, 60), _rear(act[1], d.n_views), ""))
             m.moves_since_hint = 0 if d.percept.get("hint_active") else m.moves_since_hint + 1
         elif act[0] == ASK:
-            m.questions.append((d.step, act[4], ""))
+            m.questions.append((d.step, act[4], question))
             if act[4] == 3:
                 m.moves_since_hint = 0
 

@@ -233,6 +233,9 @@ def test_each_decision_path_end_to_end(episodes, tmp_path):
     assert [a[2][4] for a in acts[:2]] == [1, 2] and kinds[:2] == [ASK, ASK]
     assert acts[2][2][:4] == [MOVE, 2, 1, 1] and acts[3][2][:4] == [MOVE, 7, 8, 8]  # view and the Grounder's cells
     assert acts[4][2] == [ASK, 0, 4, 1, 4]
+    # the Planner's question texts reach the transcript; the stop turned into a confirmation has none
+    assert [c["question"] for c in calls if c["action"] and c["action"][0] == ASK] == ["?", "?", ""]
+    assert all("question" not in c for c in calls if c["action"] and c["action"][0] != ASK)
     assert res.accounting["invalid_replies"].tolist() == [1]  # the repeated Type-1 question
     roles = [c["role"] for c in calls]
     assert roles.count("grounder") == 2 and bodies == res.accounting["requests"].sum()
