@@ -113,21 +113,23 @@ class ProcessGroup:
         except Exception as e:  # the runtime's own error type
             raise RuntimeError(f"process {self.index} of {self.count}: barrier {name!r} failed: {e}") from e
 
-    def agree(self, key: str, value: str, where: str, timeout_s: float = COORDINATOR_TIMEOUT_S) -> None:
-        """Check that every process runs with the same ``value`` (e.g. the run's
-        settings): process 0 publishes it, the others compare.
+    def agree(self, value: str, where: str, timeout_s: float = WORK_TIMEOUT_S) -> None:
+        """The barrier after which the processes start work: process 0 comes to
+        it when the run folder is ready, and publishes ``value`` (the run's
+        settings, hashed); every other process checks that it runs with the
+        same. The wait is long (process 0 may build a benchmark first); a dead
+        process 0 is detected by the runtime's heartbeats.
 
         Raises:
             ConfigError: this process's value differs from process 0's (naming ``where``).
         """
         if self.client is None:
             return
-        k = f"ignjax:agree:{key}"
+        key = "ignjax:settings"
         if self.main:
-            self.client.key_value_set(k, value)
-            return
-        theirs = self.client.blocking_key_value_get(k, int(timeout_s * 1000))
-        if theirs != value:
+            self.client.key_value_set(key, value)
+        self.barrier("start", timeout_s)
+        if not self.main and self.client.blocking_key_value_get(key, 60_000) != value:
             raise ConfigError(None, where, f"process {self.index} was started with other settings than process 0 "
                                            f"(every process of a run needs the same arguments)")
 

@@ -277,8 +277,7 @@ def run(args, settings: dict | None = None, popts: PR.ProcessOptions = PR.Proces
         kept = store.prepare(_fingerprint(args, sim, used), args.resume)
         if args.resume:
             print(f"resuming: {kept} finished batches in {store.root}", file=sys.stderr)
-    group.agree("settings", _fingerprint(args, sim, used), "arguments")
-    group.barrier("start", popts.timeout_s)
+    group.agree(_fingerprint(args, sim, used), "arguments")
     t0 = time.perf_counter()
     es = load_benchmark(args.episodes, args.scenes_root, limit=args.limit or None)
     world = make_world(es, sim)
