@@ -225,9 +225,11 @@ def process_options(args) -> ProcessOptions:
             raise ConfigError(None, where_p, f"process {pid} needs {where_n} > {pid}")
         return ProcessOptions(timeout_s=timeout)
     if pid is None:
-        raise ConfigError(None, where_p, f"{where_n} is {num}: each process needs its index 0..{num - 1}")
+        raise ConfigError(None, "--process-id", f"{where_n} is {num}: each process needs its index 0..{num - 1} "
+                                                f"(--process-id or ${ENV_PROCESS_ID})")
     if coord is None:
-        raise ConfigError(None, "--coordinator", f"{where_n} is {num}: the processes need process 0's HOST:PORT")
+        raise ConfigError(None, "--coordinator", f"{where_n} is {num}: the processes need process 0's HOST:PORT "
+                                                 f"(--coordinator or ${ENV_COORDINATOR})")
     return ProcessOptions(coordinator=coord, num_processes=num, process_id=pid, timeout_s=timeout)
 
 

@@ -196,12 +196,14 @@ def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     try:
         popts = PR.process_options(args)
-        settings = check_settings(args, popts)
-        if popts.launch:
+        if popts.launch:  # every setting checked once, here, before any process starts
             from ignjax.devices.launch import launch
 
+            check_settings(args, popts)
             return launch("ignjax.evaluate", argv, popts.launch)
-        return run(args, settings, popts)
+        # JAX's runtime joins before the settings are read (reading them may run JAX code)
+        group = PR.start(popts)
+        return run(args, check_settings(args, popts), popts, group)
     except IgnjaxError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
@@ -251,7 +253,8 @@ def _fingerprint(args, sim, used: dict) -> str:
     return h.hexdigest()
 
 
-def run(args, settings: dict | None = None, popts: PR.ProcessOptions = PR.ProcessOptions()) -> int:
+def run(args, settings: dict | None = None, popts: PR.ProcessOptions = PR.ProcessOptions(),
+        group: PR.ProcessGroup | None = None) -> int:
     # imported on use, so that --help and the other commands answer at once
     from tqdm.auto import tqdm
 
@@ -266,7 +269,13 @@ def run(args, settings: dict | None = None, popts: PR.ProcessOptions = PR.Proces
     llm_names = {a.name for a in st["llm_agents"]}
     if args.dry_run:
         return _dry_run(args, agents, st["llm_agents"], sim, llm, views, costs)
-    group = PR.start(popts)
+    group = PR.start(popts) if group is None else group
+    from ignjax.sim.rollout import batch_parts
+
+    try:  # this process's devices, known once JAX has started
+        batch_parts(None, args.parts or None)
+    except ConfigError as e:
+        raise ConfigError(None, "--parts", e.reason) from None
     quiet = args.quiet or not group.main
     # a cost-aware agent plans with the costs it is charged
     params = {a.name: make_params(a, st["agent_values"].get(a.name), costs=costs) for a in agents

@@ -76,6 +76,9 @@ def main(argv=None) -> int:
     try:
         popts = PR.process_options(args)
         studies = parse_studies(args.study)
+        # JAX's runtime joins before the configuration is resolved (its checks run JAX code); a launcher checks it
+        # once, before it starts any process
+        group = PR.start(popts) if not popts.launch else PR.SINGLE
         cfg = resolve(args.config, args.sets, args.quick)
         out = Path(args.out) if args.out else Path(cfg.run.out) / cfg.run.name
         if popts.launch or popts.distributed:
@@ -87,7 +90,6 @@ def main(argv=None) -> int:
         from ignjax.sweep.stages import run_sweep
 
         t0 = time.perf_counter()
-        group = PR.start(popts)
         run_sweep(cfg, studies, out, resume=args.resume, force=args.force, quiet=args.quiet, group=group)
         if group.main:
             print(f"wrote {out / 'report.md'} ({time.perf_counter() - t0:.0f} s)", file=sys.stderr)

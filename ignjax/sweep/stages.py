@@ -36,7 +36,7 @@ from ignjax.episodes.schema import construction_path, read_episodes, write_recor
 from ignjax.errors import ConfigError, InputError
 from ignjax.evaluate.runner import agent_batches, batch_count, episode_batches, make_world
 from ignjax.scenes.io.sources import scene_sources
-from ignjax.sim.rollout import rollout_sweep
+from ignjax.sim.rollout import batch_parts, rollout_sweep
 from ignjax.sweep.checkpoints import Checkpoints, prepare_folder
 from ignjax.sweep.report import in_loop_costs, write_outputs
 
@@ -222,6 +222,11 @@ def run_sweep(cfg: SweepConfig, studies: list[str], out: Path, *, resume: bool =
                                              "which needs a model server (llm.endpoints, llm.model)") from None
     needs_rollouts = any(s in studies for s in ("eval", "costs", "difficulty", "analysis"))
     agents = list(dict.fromkeys(list(cfg.eval.agents) + ([cfg.analysis.agent] if "analysis" in studies else [])))
+    if needs_rollouts:
+        try:  # this process's devices (before any work)
+            batch_parts(None, cfg.eval.parts or None)
+        except ConfigError as e:
+            raise ConfigError(None, "eval.parts", e.reason) from None
     store = PartStore(out / "parts")
     fp = fingerprint(cfg, studies)
     t0 = time.perf_counter()
