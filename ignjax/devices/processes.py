@@ -300,8 +300,9 @@ def start(opts: ProcessOptions) -> ProcessGroup:
         _wait_for_coordinator(coord, opts.timeout_s, where)
     left = max(5, int(round(opts.timeout_s - (time.monotonic() - t0))))
     print(f"process {pid} of {num}: joining the coordinator at {coord} (up to {left} s)", file=sys.stderr, flush=True)
-    # one visible device list per process (the local devices of this host); JAX's Slurm detection would otherwise
-    # give each task the single accelerator of its SLURM_LOCALID, and a task per host wants all of them
+    # every device of this host, unless JAX_LOCAL_DEVICE_IDS names some: the cluster's detection above is asked for
+    # no device list, since JAX's Slurm detection would give each task the one accelerator of its SLURM_LOCALID, and
+    # a task per host wants all of them
     local = os.environ.get("JAX_LOCAL_DEVICE_IDS")
     jax.distributed.initialize(coord, num, pid, local_device_ids=[int(x) for x in local.split(",")] if local else None,
                                cluster_detection_method="deactivate", initialization_timeout=left,
