@@ -19,6 +19,16 @@ of the sweep's ``[sim]`` and ``[agents.<name>]`` tables). A cost-aware agent
 plans with the costs it is charged (``--costs``).
 The metrics can be recomputed from either outcome file alone
 (``ignjax.evaluate.outcomes.metric_rows(read_outcomes(path))``).
+
+Several processes (``--processes N`` on this machine; ``--coordinator``,
+``--num-processes``, ``--process-id`` or ``--cluster`` for one process per
+host, :mod:`ignjax.devices.processes`) split the JAX-native agents'
+batches: process i runs the i-th contiguous block of each agent's batches
+of ``--batch`` episodes and writes each finished batch to ``OUT/parts/``;
+process 0 merges them in episode order and writes the outputs once, the
+same bytes as one process. ``--resume`` reuses the parts an interrupted run
+with the same settings wrote (with any number of processes); ``OUT/parts/``
+is deleted when the outputs are written.
 """
 
 from __future__ import annotations
@@ -30,7 +40,10 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
+
 from ignjax.arrays import parse_assignment, parse_floats
+from ignjax.devices import processes as PR
 from ignjax.errors import ConfigError, IgnjaxError
 from ignjax.fileio import atomic_write
 from ignjax.protocol import LOCKED_COSTS, SUCCESS_THRESHOLDS
@@ -67,6 +80,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "values in TOML syntax; repeatable")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
     p.add_argument("--limit", type=int, default=0, help="only the first N episodes of the file, for every agent")
+    p.add_argument("--resume", action="store_true",
+                   help="reuse the batches an interrupted run with the same settings left in OUT/parts")
+    PR.add_arguments(p)
     g = p.add_argument_group("MLLM agents (" + ", ".join(sorted(LLM_AGENTS)) + "); settings also as --set llm.<key>=<value>"
                              " and --set views.<key>=<value>")
     g.add_argument("--llm-endpoint", action="append", default=[], metavar="URL",
@@ -181,35 +197,41 @@ def _dry_run(args, agents, llm_agents, sim, llm, views, costs) -> int:
 
 
 def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser().parse_args(argv)
     try:
-        return run(args)
+        popts = PR.process_options(args)
+        if popts.launch:  # every setting checked once, here, before any process starts
+            from ignjax.devices.launch import launch
+
+            check_settings(args, popts)
+            return launch("ignjax.evaluate", argv, popts.launch)
+        # JAX's runtime joins before the settings are read (reading them may run JAX code)
+        group = PR.start(popts)
+        return run(args, check_settings(args, popts), popts, group)
     except IgnjaxError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
 
 
-def run(args) -> int:
-    # imported on use, so that --help and the other commands answer at once
-    from tqdm.auto import tqdm
+def check_settings(args, popts: PR.ProcessOptions = PR.ProcessOptions()) -> dict:
+    """Every setting of ``args``, checked before any work (and before JAX starts).
 
-    # imported on use, so that --help and the other commands answer at once
-    from ignjax.evaluate import metrics as M
+    Raises:
+        ConfigError: naming the flag and the reason.
+    """
     from ignjax.agents import get_agent
-    from ignjax.agents.params import make_params, param_values_of
-    from ignjax.episodes.dataset import load_benchmark
-    from ignjax.evaluate.runner import make_world, run_agent
-    from ignjax.evaluate.outcomes import (TRAJECTORY_FILE, metric_rows, model_totals, outcome_rows, per_episode_text,
-                                          write_metric_table, write_outcomes, write_trajectories)
-
     from ignjax.agents.llm.catalog import LLM_AGENTS, get_llm_agent
-    from ignjax.evaluate.hostloop import run_llm_agent, write_transcripts
 
     agents = [get_llm_agent(a) if a in LLM_AGENTS else get_agent(a) for a in args.agent]
     sim, agent_values, sections = parse_settings(args.set, [a.name for a in agents], ("llm", "views"))
     out_dir = Path(args.out)
     llm_agents = [a for a in agents if a.name in LLM_AGENTS]
     llm, views = llm_settings(args, sections, out_dir) if llm_agents else (None, None)
+    if llm_agents and (popts.launch or popts.distributed):
+        raise ConfigError(None, "--processes", f"the MLLM agents ({', '.join(a.name for a in llm_agents)}) run in "
+                                               "one process (their model server is what runs in parallel); "
+                                               "evaluate them without --processes / --num-processes / --cluster")
     if args.limit < 0:
         raise ConfigError(None, "--limit", f"must be >= 0, got {args.limit}")
     thresholds = parse_floats(args.thresholds, 0, "--thresholds")
@@ -220,19 +242,108 @@ def run(args) -> int:
         raise ConfigError(None, "--batch", f"must be >= 1, got {args.batch}")
     if args.parts < 0:
         raise ConfigError(None, "--parts", f"must be >= 0, got {args.parts}")
+    if not Path(args.episodes).is_file():
+        raise ConfigError(None, "--episodes", f"{args.episodes}: file not found")
+    return {"agents": agents, "sim": sim, "agent_values": agent_values, "out_dir": out_dir, "llm_agents": llm_agents,
+            "llm": llm, "views": views, "thresholds": thresholds, "costs": costs}
+
+
+def _fingerprint(args, sim, used: dict) -> str:
+    """What a JAX-native agent's outcomes depend on: a part of ``OUT/parts`` is reused only under the same."""
+    import hashlib
+
+    h = hashlib.sha256(Path(args.episodes).read_bytes())
+    h.update(json.dumps({"scenes_root": args.scenes_root, "limit": args.limit, "batch": args.batch, "seed": args.seed,
+                         "sim": sim.to_dict(), "agents": used}, sort_keys=True, default=str).encode())
+    return h.hexdigest()
+
+
+def run(args, settings: dict | None = None, popts: PR.ProcessOptions = PR.ProcessOptions(),
+        group: PR.ProcessGroup | None = None) -> int:
+    # imported on use, so that --help and the other commands answer at once
+    from tqdm.auto import tqdm
+
+    from ignjax.agents.params import make_params, param_values_of
+    from ignjax.devices.parts import PartStore
+    from ignjax.episodes.dataset import load_benchmark
+    from ignjax.evaluate.runner import agent_batches, batch_count, make_world
+
+    st = settings or check_settings(args, popts)
+    agents, sim, out_dir, llm, views = st["agents"], st["sim"], st["out_dir"], st["llm"], st["views"]
+    thresholds, costs = st["thresholds"], st["costs"]
+    llm_names = {a.name for a in st["llm_agents"]}
     if args.dry_run:
-        return _dry_run(args, agents, llm_agents, sim, llm, views, costs)
+        return _dry_run(args, agents, st["llm_agents"], sim, llm, views, costs)
+    group = PR.start(popts) if group is None else group
+    from ignjax.sim.rollout import batch_parts
+
+    try:  # this process's devices, known once JAX has started
+        batch_parts(None, args.parts or None)
+    except ConfigError as e:
+        raise ConfigError(None, "--parts", e.reason) from None
+    quiet = args.quiet or not group.main
+    # a cost-aware agent plans with the costs it is charged
+    params = {a.name: make_params(a, st["agent_values"].get(a.name), costs=costs) for a in agents
+              if a.name not in llm_names}
+    used: dict[str, dict] = {name: param_values_of(p) for name, p in params.items()}
+    store = PartStore(out_dir / "parts")
+    if group.main:
+        kept = store.prepare(_fingerprint(args, sim, used), args.resume)
+        if args.resume:
+            print(f"resuming: {kept} finished batches in {store.root}", file=sys.stderr)
+    group.agree(_fingerprint(args, sim, used), "arguments")
     t0 = time.perf_counter()
     es = load_benchmark(args.episodes, args.scenes_root, limit=args.limit or None)
     world = make_world(es, sim)
-    print(f"loaded {len(es)} episodes in {len(es.bank.scene_ids)} scenes ({time.perf_counter() - t0:.1f} s)", file=sys.stderr)
+    if group.main:
+        print(f"loaded {len(es)} episodes in {len(es.bank.scene_ids)} scenes ({time.perf_counter() - t0:.1f} s)",
+              file=sys.stderr)
+    n_batches = batch_count(len(es), args.batch)
+    for agent in agents:
+        if agent.name in llm_names:
+            continue
+        t1 = time.perf_counter()
+        bar = (lambda it, name=agent.name: tqdm(it, desc=name, unit="batch", file=sys.stderr, disable=quiet,
+                                                dynamic_ncols=True))
+
+        def compute(select, agent=agent, bar=bar):
+            for i, out, traj in agent_batches(es, agent, params=params[agent.name], batch=args.batch, seed=args.seed,
+                                              progress=bar, world=world, parts=args.parts or None, select=select):
+                yield i, {"out": _fields(out), "traj": _fields(traj)}
+
+        done, reused = store.run_share(f"eval/{agent.name}", n_batches, group, compute)
+        if not quiet:
+            print(f"{agent.name}: {done} batches of {args.batch} episodes in {time.perf_counter() - t1:.1f} s"
+                  + (f" ({reused} from an earlier run)" if reused else "")
+                  + (f" (process 0 of {group.count})" if group.count > 1 else ""), file=sys.stderr)
+    group.barrier("parts")
+    if group.main:
+        _write_outputs(args, st, es, store, n_batches, used, llm_names)
+        store.remove()
+    group.barrier("written")
+    return 0
+
+
+def _fields(obj) -> dict:
+    return {f.name: np.asarray(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
+
+
+def _write_outputs(args, st: dict, es, store, n_batches: int, used: dict, llm_names: set) -> None:
+    """Process 0: the JAX-native agents' outcomes from the parts, the MLLM agents' from the host loop, every file."""
+    from types import SimpleNamespace
+
+    from ignjax.evaluate import metrics as M
+    from ignjax.evaluate.hostloop import run_llm_agent, write_transcripts
+    from ignjax.evaluate.outcomes import (TRAJECTORY_FILE, metric_rows, model_totals, outcome_rows, per_episode_text,
+                                          write_metric_table, write_outcomes, write_trajectories)
+
+    agents, sim, out_dir, llm, views = st["agents"], st["sim"], st["out_dir"], st["llm"], st["views"]
+    thresholds, costs = st["thresholds"], st["costs"]
     rows = []
     trajectories = {}
-    used: dict[str, dict] = {}
-    llm_stats = {}
     for agent in agents:
         t1 = time.perf_counter()
-        if agent.name in LLM_AGENTS:
+        if agent.name in llm_names:
             res = run_llm_agent(es, agent, llm, sim=sim, views=views, batch=args.llm_batch, seed=args.seed, costs=costs,
                                 out=out_dir, save_images=args.save_images, progress=not args.quiet)
             rows += outcome_rows(agent.name, es.records, res.outcomes, res.accounting, llm.prices)
@@ -240,20 +351,14 @@ def run(args) -> int:
             write_transcripts(out_dir, agent.name, res.transcripts)
             used[agent.name] = {"options": {k: v for k, v in vars(agent).items()}, "llm": llm.public_dict(),
                                 "views": dataclasses.asdict(views)}
-            llm_stats[agent.name] = res.stats
             print(f"{agent.name}: {len(es)} episodes in {time.perf_counter() - t1:.1f} s, "
                   f"{res.stats['requests']} requests sent ({res.stats['resumed']} episodes from an earlier run)",
                   file=sys.stderr)
             continue
-        bar = (lambda it, name=agent.name: tqdm(it, desc=name, unit="batch", file=sys.stderr, disable=args.quiet, dynamic_ncols=True))
-        # a cost-aware agent plans with the costs it is charged
-        params = make_params(agent, agent_values.get(agent.name), costs=costs)
-        used[agent.name] = param_values_of(params)
-        out, traj = run_agent(es, agent, params=params, batch=args.batch, seed=args.seed, progress=bar, world=world,
-                              parts=args.parts or None)
-        rows += outcome_rows(agent.name, es.records, out)
-        trajectories[agent.name] = traj
-        print(f"{agent.name}: {len(es)} episodes in {time.perf_counter() - t1:.1f} s", file=sys.stderr)
+        tree = store.gather(f"eval/{agent.name}", n_batches)
+        rows += outcome_rows(agent.name, es.records, SimpleNamespace(**tree["out"]))
+        trajectories[agent.name] = tree["traj"]
+    used = {a.name: used[a.name] for a in agents}  # in the order of --agent
     p_parquet, p_csv = write_outcomes(rows, out_dir)
     metrics = metric_rows(rows, thresholds, costs, args.require_stop)
     write_metric_table(metrics, out_dir / "metrics.csv")
@@ -279,7 +384,6 @@ def run(args) -> int:
         print(f"{name}: {per_episode_text(totals)}")
     print(f"wrote {p_parquet}, {p_csv}, {out_dir / 'metrics.csv'}, {out_dir / TRAJECTORY_FILE} and "
           f"{out_dir / 'run.json'} (view the episodes: python -m ignjax.view {out_dir})")
-    return 0
 
 
 if __name__ == "__main__":

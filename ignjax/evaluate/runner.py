@@ -29,16 +29,28 @@ def make_world(es: EpisodeSet, config: SimConfig = SimConfig()) -> World:
     return World(es.bank, es.fields, config)
 
 
-def episode_batches(es: EpisodeSet, batch: int, seed: int = 0, progress=None):
+def batch_count(n: int, batch: int) -> int:
+    """How many chunks :func:`episode_batches` cuts ``n`` episodes into."""
+    batch = max(1, min(int(batch), n))
+    return -(-n // batch)
+
+
+def episode_batches(es: EpisodeSet, batch: int, seed: int = 0, progress=None, select=None):
     """Yield ``(n_real, specs, keys)`` for consecutive chunks of ``batch``
     episodes of ``es``: the last chunk padded with masked copies so every
     chunk has the same shape (one compiled rollout), and each episode's key
     from the seed and its index in the file (:func:`ignjax.sim.rollout.episode_keys`).
-    ``progress`` optionally wraps the iterable of chunk starts (a progress bar)."""
+    ``select`` optionally names the chunks to yield (indices in
+    ``range(batch_count(len(es), batch))``, in that order): a process's
+    share of a run (:mod:`ignjax.devices.processes`); a chunk is the same
+    whichever process runs it. ``progress`` optionally wraps the iterable
+    of chunk starts (a progress bar)."""
     n = len(es)
     batch = max(1, min(int(batch), n))
     keys_all = episode_keys(seed, np.arange(n))
     starts = list(range(0, n, batch))
+    if select is not None:
+        starts = [starts[i] for i in select]
     for start in (progress(starts) if progress else starts):
         idx = np.arange(start, min(start + batch, n))
         specs = jax.tree.map(lambda a: a[idx], es.specs)
@@ -56,6 +68,17 @@ def run_agent(es: EpisodeSet, agent: Agent | str, *, params=None, batch: int = 2
     Returns:
         (OutcomeRow, Trajectory) as numpy pytrees with leading axis len(es).
     """
+    outs = [(out, traj) for _, out, traj in agent_batches(es, agent, params=params, batch=batch, seed=seed,
+                                                          config=config, progress=progress, world=world, parts=parts)]
+    return jax.tree.map(lambda *xs: np.concatenate(xs), *outs)
+
+
+def agent_batches(es: EpisodeSet, agent: Agent | str, *, params=None, batch: int = 256, seed: int = 0,
+                  config: SimConfig = SimConfig(), progress=None, world: World | None = None, parts: int | None = None,
+                  select=None):
+    """:func:`run_agent` one chunk at a time: yield ``(index, OutcomeRow,
+    Trajectory)`` (numpy, the chunk's real episodes only) for the chunks
+    ``select`` names (default all; :func:`episode_batches`)."""
     agent = get_agent(agent) if isinstance(agent, str) else agent
     params = agent.default_params() if params is None else params
     world = world or make_world(es, config)
@@ -63,11 +86,11 @@ def run_agent(es: EpisodeSet, agent: Agent | str, *, params=None, batch: int = 2
         raise ConfigError(None, "sim.n_views", f"the built-in JAX agents plan with {N_VIEWS} views; got "
                           f"{world.config.n_views} (other view counts are for image-based agents)")
     check_specs(world, es.specs)
-    outs = []
-    for n_real, specs, keys in episode_batches(es, batch, seed, progress):
+    select = list(range(batch_count(len(es), batch))) if select is None else list(select)
+    for i, (n_real, specs, keys) in zip(select, episode_batches(es, batch, seed, progress, select)):
         out, traj = rollout(world, specs, agent, params, keys, parts=parts)
-        outs.append(jax.tree.map(lambda a, m=n_real: np.asarray(a)[:m], (out, traj)))
-    return jax.tree.map(lambda *xs: np.concatenate(xs), *outs)
+        out, traj = jax.tree.map(lambda a, m=n_real: np.asarray(a)[:m], (out, traj))
+        yield i, out, traj
 
 
-__all__ = ["episode_batches", "make_world", "run_agent"]
+__all__ = ["agent_batches", "batch_count", "episode_batches", "make_world", "run_agent"]

@@ -131,17 +131,20 @@ def batch_parts(n_rows: int | None = None, parts: int | None = None) -> int:
     Args:
         n_rows: rows of the batch (unused: any batch is padded to a multiple
             of the count; kept so callers can say which batch they mean).
-        parts: requested devices; None or 0: every device of the default
-            backend (``jax.devices()``: the GPUs, the TPU chips, or the CPU
-            devices of :func:`ignjax.devices.configure_cpu_devices`).
+        parts: requested devices; None or 0: every local device of the
+            default backend (``jax.local_devices()``: this process's GPUs,
+            TPU chips, or the CPU devices of
+            :func:`ignjax.devices.configure_cpu_devices`; in a run of several
+            processes each shards its own batches over its own devices,
+            :mod:`ignjax.devices.processes`).
 
     Returns:
-        int in 1..``jax.device_count()``.
+        int in 1..``jax.local_device_count()``.
 
     Raises:
         ConfigError: ``parts`` is negative or more than the devices there are.
     """
-    available = jax.device_count()
+    available = jax.local_device_count()
     if not parts:
         if parts is not None and parts < 0:
             raise ConfigError(None, "parts", f"must be >= 0 (0: every device), got {parts}")
@@ -156,8 +159,8 @@ def batch_parts(n_rows: int | None = None, parts: int | None = None) -> int:
 
 
 def device_mesh(parts: int) -> Mesh:
-    """A 1-D mesh (axis :data:`AXIS`) over the first ``parts`` devices."""
-    return Mesh(np.array(jax.devices()[:parts]), (AXIS,))
+    """A 1-D mesh (axis :data:`AXIS`) over this process's first ``parts`` devices."""
+    return Mesh(np.array(jax.local_devices()[:parts]), (AXIS,))
 
 
 def _widths(rows: int, episodes: int, chunk: int | None) -> tuple[int, int, int]:
@@ -381,7 +384,7 @@ def rollout(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.Array, 
         chunk: rows per vectorised call (:func:`rollout_rows`; default: an
             eighth of the whole batch, whatever the device count).
         parts: devices to shard over: None or 0 for every device
-            (``jax.devices()``), else 1 up to their number (:func:`batch_parts`).
+            of this process (``jax.local_devices()``), else 1 up to their number (:func:`batch_parts`).
 
     Returns:
         (OutcomeRow, Trajectory) with leading axis E.

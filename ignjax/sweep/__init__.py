@@ -24,6 +24,11 @@ Every rollout is checkpointed as it finishes; a run interrupted (even by
 SIGKILL) and continued with ``--resume`` writes the same bytes as an
 uninterrupted one. Timings go to stderr only, never into the run folder.
 
+``--processes N`` (or one process per host, :mod:`ignjax.devices.processes`)
+splits every rollout stage's batches over processes; each writes its
+finished batches to ``parts/`` and process 0 merges, checkpoints and
+writes the report: the same bytes as one process.
+
 Benchmark: ``benchmark.episodes`` when set; else the shipped
 ``scenes/benchmark.jsonl.gz`` (500 episodes, 150/200/150, seed 0) when the
 benchmark settings are the defaults; else one built from

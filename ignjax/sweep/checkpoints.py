@@ -60,13 +60,26 @@ class Checkpoints:
         return self._path(name).is_dir()
 
     def load(self, name: str) -> dict:
-        with ocp.PyTreeCheckpointer() as ck:
+        with _checkpointer() as ck:
             return ck.restore(self._path(name).resolve())
 
     def save(self, name: str, tree: dict) -> None:
         self.root.mkdir(parents=True, exist_ok=True)
-        with ocp.PyTreeCheckpointer() as ck:
+        with _checkpointer() as ck:
             ck.save(self._path(name).resolve(), tree)
+
+
+def _checkpointer():
+    """Orbax's checkpointer for this process alone: in a run of several
+    processes only process 0 saves and loads stages, so orbax must not wait
+    for the others at its barriers."""
+    import jax
+
+    if jax.process_count() == 1:
+        return ocp.PyTreeCheckpointer()
+    me = jax.process_index()
+    mp = ocp.options.MultiprocessingOptions(primary_host=me, active_processes={me})
+    return ocp.Checkpointer(ocp.PyTreeCheckpointHandler(multiprocessing_options=mp), multiprocessing_options=mp)
 
 
 __all__ = ["Checkpoints", "prepare_folder"]

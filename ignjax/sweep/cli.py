@@ -8,6 +8,7 @@ import sys
 import time
 from pathlib import Path
 
+from ignjax.devices import processes as PR
 from ignjax.errors import ConfigError, IgnjaxError
 
 STUDIES: tuple[str, ...] = ("eval", "costs", "difficulty", "derive-costs", "analysis")
@@ -34,6 +35,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--resume", action="store_true", help="continue an interrupted run in the same folder")
     p.add_argument("--force", action="store_true", help="replace a folder that holds another run")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    PR.add_arguments(p)
     return p
 
 
@@ -48,24 +50,53 @@ def parse_studies(items: list[str]) -> list[str]:
     return [s for s in STUDIES if s in names]
 
 
+def check_processes(cfg, studies: list[str]) -> None:
+    """A sweep of several processes rolls out JAX-native agents only.
+
+    Raises:
+        ConfigError: an MLLM agent is among the agents rolled out (naming ``--processes``).
+    """
+    from ignjax.agents.llm.catalog import LLM_AGENTS
+
+    agents = list(cfg.eval.agents) + ([cfg.analysis.agent] if "analysis" in studies else [])
+    llm = [a for a in dict.fromkeys(agents) if a in LLM_AGENTS]
+    if llm and any(s in studies for s in ("eval", "costs", "difficulty", "analysis")):
+        raise ConfigError(None, "--processes", f"the MLLM agents ({', '.join(llm)}) run in one process (their model "
+                                               "server is what runs in parallel); run this sweep without --processes "
+                                               "/ --num-processes / --cluster")
+
+
 def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser().parse_args(argv)
     # Deferred so that `--help` and option errors answer without loading jax, scipy, orbax, the simulator and
     # the studies (measured on the 2-core dev machine: `--help` 0.15 s; 4.6 s with these two at the top).
     from ignjax.config import resolve
-    from ignjax.sweep.stages import run_sweep
 
     try:
+        popts = PR.process_options(args)
         studies = parse_studies(args.study)
+        # JAX's runtime joins before the configuration is resolved (its checks run JAX code); a launcher checks it
+        # once, before it starts any process
+        group = PR.start(popts) if not popts.launch else PR.SINGLE
         cfg = resolve(args.config, args.sets, args.quick)
         out = Path(args.out) if args.out else Path(cfg.run.out) / cfg.run.name
+        if popts.launch or popts.distributed:
+            check_processes(cfg, studies)
+        if popts.launch:
+            from ignjax.devices.launch import launch
+
+            return launch("ignjax.sweep", argv, popts.launch)
+        from ignjax.sweep.stages import run_sweep
+
         t0 = time.perf_counter()
-        run_sweep(cfg, studies, out, resume=args.resume, force=args.force, quiet=args.quiet)
-        print(f"wrote {out / 'report.md'} ({time.perf_counter() - t0:.0f} s)", file=sys.stderr)
+        run_sweep(cfg, studies, out, resume=args.resume, force=args.force, quiet=args.quiet, group=group)
+        if group.main:
+            print(f"wrote {out / 'report.md'} ({time.perf_counter() - t0:.0f} s)", file=sys.stderr)
         return 0
     except IgnjaxError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
 
 
-__all__ = ["STUDIES", "build_parser", "main", "parse_studies"]
+__all__ = ["STUDIES", "build_parser", "check_processes", "main", "parse_studies"]

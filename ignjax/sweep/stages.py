@@ -29,14 +29,16 @@ from tqdm.auto import tqdm
 from ignjax.agents import get_agent
 from ignjax.agents.llm.catalog import LLM_AGENTS, get_llm_agent
 from ignjax.agents.params import plans_with_costs
-from ignjax.config import SweepConfig, digest
+from ignjax.config import SweepConfig, digest, fingerprint
+from ignjax.devices.parts import PartStore
+from ignjax.devices.processes import SINGLE, ProcessGroup
 from ignjax.episodes.construct import BuildConfig, build_benchmark
 from ignjax.episodes.dataset import load_benchmark
 from ignjax.episodes.schema import construction_path, read_episodes, write_records
 from ignjax.errors import ConfigError, InputError
-from ignjax.evaluate.runner import episode_batches, make_world, run_agent
+from ignjax.evaluate.runner import agent_batches, batch_count, episode_batches, make_world
 from ignjax.scenes.io.sources import scene_sources
-from ignjax.sim.rollout import rollout_sweep
+from ignjax.sim.rollout import batch_parts, rollout_sweep
 from ignjax.sweep.checkpoints import Checkpoints, prepare_folder
 from ignjax.sweep.report import in_loop_costs, write_outputs
 
@@ -98,26 +100,46 @@ def load_episodes(cfg: SweepConfig, path: Path):
 # ---------------------------------------------------------------------------
 
 
-def run_eval_stage(es, world, agent_name: str, cfg: SweepConfig, ckpt: Checkpoints, bar=None) -> dict:
-    """Outcomes and trajectories of one agent (from the checkpoint when there)."""
+def _batch_sizes(n: int, batch: int, select) -> int:
+    """Episodes in the chunks ``select`` of ``n`` episodes cut into ``batch``."""
+    batch = max(1, min(int(batch), n))
+    return sum(min(batch, n - i * batch) for i in select)
+
+
+def eval_stage_parts(es, world, agent_name: str, cfg: SweepConfig, store: PartStore, group: ProcessGroup = SINGLE,
+                     bar=None) -> int:
+    """This process's share of one agent's rollouts, as part files (:mod:`ignjax.devices.parts`).
+
+    Returns:
+        Episodes rolled out here (for a progress display).
+    """
     name = f"eval/{agent_name}"
-    if ckpt.has(name):
-        if bar is not None:
-            bar.update(len(es))
-        return ckpt.load(name)
-
-    def prog(chunks):
-        for c in chunks:
-            yield c
-            if bar is not None:
-                bar.update(min(cfg.eval.batch, len(es) - c))
-
     # a cost-aware agent plans with the costs it is charged (eval.costs)
     params = cfg.agents.make(agent_name, costs=cfg.eval.costs)
-    out, traj = run_agent(es, agent_name, params=params, batch=cfg.eval.batch, seed=cfg.run.seed, world=world,
-                          progress=prog, parts=cfg.eval.parts or None)
-    tree = {"out": _to_tree(out), "traj": _to_tree(traj)}
+    n = len(es)
+
+    def compute(select):
+        def prog(chunks):
+            for c in chunks:
+                yield c
+                if bar is not None:
+                    bar.update(min(cfg.eval.batch, n - c))
+
+        for i, out, traj in agent_batches(es, agent_name, params=params, batch=cfg.eval.batch, seed=cfg.run.seed,
+                                          world=world, progress=prog, parts=cfg.eval.parts or None, select=select):
+            yield i, {"out": _to_tree(out), "traj": _to_tree(traj)}
+
+    store.run_share(name, batch_count(n, cfg.eval.batch), group, compute)
+    return _batch_sizes(n, cfg.eval.batch, group.share(batch_count(n, cfg.eval.batch)))
+
+
+def merge_stage(name: str, n_batches: int, ckpt: Checkpoints, store: PartStore, axes=None, extra=None) -> dict:
+    """A stage's result from its parts (process 0), checkpointed; the parts are then deleted."""
+    if ckpt.has(name):
+        return ckpt.load(name)
+    tree = {**store.gather(name, n_batches, axes), **(extra or {})}
     ckpt.save(name, tree)
+    store.remove(name)
     return tree
 
 
@@ -139,32 +161,36 @@ def run_llm_stage(es, agent_name: str, cfg: SweepConfig, out: Path, bar=None, qu
             "questions": question_texts(res.transcripts)}
 
 
-def run_costs_stage(es, world, cfg: SweepConfig, ckpt: Checkpoints, bar=None) -> dict:
-    """The cost-aware agent under K charged cost vectors x all episodes (vmapped over K)."""
-    name = "costs/in_loop"
+def _costs_setup(es, cfg: SweepConfig):
     costs, _ = in_loop_costs(cfg)
-    if ckpt.has(name):
-        if bar is not None:
-            bar.update(len(es) * len(costs))
-        return ckpt.load(name)
     agent = get_agent(cfg.costs.agent)
     if not plans_with_costs(agent):
         raise ConfigError(None, "costs.agent", f"{agent.name!r} has no cost parameters to sweep")
+    K = len(costs)
+    batch = max(1, cfg.eval.batch // max(1, K // 4))
+    return costs, agent, batch
+
+
+def costs_stage_parts(es, world, cfg: SweepConfig, store: PartStore, group: ProcessGroup = SINGLE, bar=None) -> int:
+    """This process's share of the cost-aware agent under K charged cost vectors x all episodes (vmapped over K):
+    every cost vector of its chunks of episodes, so that each chunk is the same program as in one process."""
+    costs, agent, batch = _costs_setup(es, cfg)
     base = cfg.agents.make(agent.name)
     K = len(costs)
     params = jax.tree.map(lambda x: jnp.broadcast_to(x, (K,) + jnp.shape(x)), base)
     # each setting plans with the cost vector it is charged
     params = dataclasses.replace(params, costs=jnp.asarray(costs, jnp.float32))
-    batch = max(1, cfg.eval.batch // max(1, K // 4))
-    parts = []
-    for n_real, specs, keys in episode_batches(es, batch, cfg.run.seed):
-        out, _ = rollout_sweep(world, specs, agent, params, keys, parts=cfg.eval.parts or None)
-        parts.append({k: v[:, :n_real] for k, v in _to_tree(out).items()})
-        if bar is not None:
-            bar.update(n_real * K)
-    tree = {"out": {k: np.concatenate([p[k] for p in parts], axis=1) for k in parts[0]}, "costs": costs}
-    ckpt.save(name, tree)
-    return tree
+
+    def compute(select):
+        for i, (n_real, specs, keys) in zip(select, episode_batches(es, batch, cfg.run.seed, select=select)):
+            out, _ = rollout_sweep(world, specs, agent, params, keys, parts=cfg.eval.parts or None)
+            yield i, {"out": {k: v[:, :n_real] for k, v in _to_tree(out).items()}}
+            if bar is not None:
+                bar.update(n_real * K)
+
+    n = batch_count(len(es), batch)
+    store.run_share("costs/in_loop", n, group, compute)
+    return _batch_sizes(len(es), batch, group.share(n)) * K
 
 
 # ---------------------------------------------------------------------------
@@ -173,10 +199,20 @@ def run_costs_stage(es, world, cfg: SweepConfig, ckpt: Checkpoints, bar=None) ->
 
 
 def run_sweep(cfg: SweepConfig, studies: list[str], out: Path, *, resume: bool = False, force: bool = False,
-              quiet: bool = False) -> dict:
+              quiet: bool = False, group: ProcessGroup = SINGLE) -> dict:
     """Run ``studies`` with configuration ``cfg`` (see :func:`ignjax.config.resolve`) into ``out``.
 
-    Returns a dict of every study's results (also written to ``out``).
+    With several processes (``group``, :mod:`ignjax.devices.processes`),
+    every process calls this with the same arguments: process 0 prepares
+    the run folder, each process rolls out its share of every stage's
+    batches (the ``i``-th contiguous block; a sweep's K cost vectors stay
+    together, so every batch is the same program as in one process) into
+    ``out/parts/``, and process 0 merges them, checkpoints each stage and
+    writes the report; the MLLM agents' stages run in process 0 (the
+    command line refuses them with several processes).
+
+    Returns a dict of every study's results (also written to ``out``; on
+    processes other than 0, an empty dict).
     """
     out = Path(out)
     if cfg.derive_costs.annotations and not Path(cfg.derive_costs.annotations).is_file():
@@ -187,34 +223,69 @@ def run_sweep(cfg: SweepConfig, studies: list[str], out: Path, *, resume: bool =
         except ConfigError as e:
             raise ConfigError(None, e.where, f"{e.reason}: analysis.agent is the MLLM agent {cfg.analysis.agent!r}, "
                                              "which needs a model server (llm.endpoints, llm.model)") from None
-    prepare_folder(out, cfg, studies, resume, force)
     needs_rollouts = any(s in studies for s in ("eval", "costs", "difficulty", "analysis"))
-    results: dict = {"config": cfg, "studies": studies}
+    agents = list(dict.fromkeys(list(cfg.eval.agents) + ([cfg.analysis.agent] if "analysis" in studies else [])))
+    if needs_rollouts:
+        try:  # this process's devices (before any work)
+            batch_parts(None, cfg.eval.parts or None)
+        except ConfigError as e:
+            raise ConfigError(None, "eval.parts", e.reason) from None
+    store = PartStore(out / "parts")
+    fp = fingerprint(cfg, studies)
     t0 = time.perf_counter()
+    if group.main:
+        prepare_folder(out, cfg, studies, resume, force)
+        if needs_rollouts:
+            benchmark_path(cfg, Path(cfg.run.out))  # built once, by process 0
+            kept = store.prepare(fp, resume=True)  # prepare_folder has checked that the folder holds this run
+            if kept and resume:
+                print(f"resuming: {kept} finished batches in {store.root}", file=sys.stderr)
+    group.agree(fp, "--config/--set/--study")
+    results: dict = {"config": cfg, "studies": studies}
     if needs_rollouts:
         path = benchmark_path(cfg, Path(cfg.run.out))
         es = load_episodes(cfg, path)
-        print(f"benchmark {path} ({len(es)} episodes) ready in {time.perf_counter() - t0:.1f} s", file=sys.stderr)
+        if group.main:
+            print(f"benchmark {path} ({len(es)} episodes) ready in {time.perf_counter() - t0:.1f} s", file=sys.stderr)
         world = make_world(es, cfg.sim)
-        agents = list(dict.fromkeys(list(cfg.eval.agents) + ([cfg.analysis.agent] if "analysis" in studies else [])))
-        k_costs = len(in_loop_costs(cfg)[0]) if "costs" in studies else 0
-        total = len(es) * (len(agents) + k_costs)
         ckpt = Checkpoints(out / "checkpoints")
-        with tqdm(total=total, desc="rollouts", unit="ep", file=sys.stderr, disable=quiet, dynamic_ncols=True) as bar:
+        jax_agents = [a for a in agents if a not in LLM_AGENTS]
+        share = group.share
+        k_costs = len(in_loop_costs(cfg)[0]) if "costs" in studies else 0
+        costs_batch = max(1, cfg.eval.batch // max(1, k_costs // 4))
+        total = (sum(0 if ckpt.has(f"eval/{a}") else _batch_sizes(len(es), cfg.eval.batch,
+                                                                  share(batch_count(len(es), cfg.eval.batch)))
+                     for a in jax_agents)
+                 + (_batch_sizes(len(es), costs_batch, share(batch_count(len(es), costs_batch))) * k_costs
+                    if k_costs and not ckpt.has("costs/in_loop") else 0))
+        with tqdm(total=total, desc="rollouts", unit="ep", file=sys.stderr, disable=quiet or not group.main,
+                  dynamic_ncols=True) as bar:
+            for a in jax_agents:
+                if not ckpt.has(f"eval/{a}"):
+                    bar.set_postfix_str(a)
+                    eval_stage_parts(es, world, a, cfg, store, group, bar)
+            if k_costs and not ckpt.has("costs/in_loop"):
+                bar.set_postfix_str(f"{cfg.costs.agent} x {k_costs} cost vectors")
+                costs_stage_parts(es, world, cfg, store, group, bar)
+        group.barrier("parts")
+        if group.main:
             rollouts = {}
             for a in agents:
-                bar.set_postfix_str(a)
-                rollouts[a] = (run_llm_stage(es, a, cfg, out, bar, quiet) if a in LLM_AGENTS
-                               else run_eval_stage(es, world, a, cfg, ckpt, bar))
-            if "costs" in studies:
-                bar.set_postfix_str(f"{cfg.costs.agent} x {k_costs} cost vectors")
-                results["in_loop"] = run_costs_stage(es, world, cfg, ckpt, bar)
-        print(f"rollouts done in {time.perf_counter() - t0:.1f} s", file=sys.stderr)
-        results["episodes"] = es
-        results["rollouts"] = rollouts
-    write_outputs(results, out)
-    return results
+                rollouts[a] = (run_llm_stage(es, a, cfg, out, None, quiet) if a in LLM_AGENTS
+                               else merge_stage(f"eval/{a}", batch_count(len(es), cfg.eval.batch), ckpt, store))
+            if k_costs:
+                costs = in_loop_costs(cfg)[0]
+                results["in_loop"] = merge_stage("costs/in_loop", batch_count(len(es), costs_batch), ckpt, store,
+                                                 {"out": 1}, {"costs": costs})
+            print(f"rollouts done in {time.perf_counter() - t0:.1f} s", file=sys.stderr)
+            results["episodes"] = es
+            results["rollouts"] = rollouts
+    if group.main:
+        write_outputs(results, out)
+        store.remove()
+    group.barrier("written")
+    return results if group.main else {}
 
 
-__all__ = ["REPO_SCENES", "SHIPPED_BENCHMARK", "benchmark_path", "load_episodes", "run_costs_stage",
-           "run_eval_stage", "run_llm_stage", "run_sweep"]
+__all__ = ["REPO_SCENES", "SHIPPED_BENCHMARK", "benchmark_path", "costs_stage_parts", "eval_stage_parts",
+           "load_episodes", "merge_stage", "run_llm_stage", "run_sweep"]
