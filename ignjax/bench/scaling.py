@@ -31,7 +31,7 @@ resident high-water mark after the point (points run in increasing size).
 
 ``--quick`` stops each curve early (B up to 4,096, 12 and 50 scenes,
 K up to 256). The figure (``scaling.png``: one panel per curve, steps/s and
-peak memory on log axes) and the record (``scaling.json``) are written to
+peak memory, sizes on a log axis) and the record (``scaling.json``) are written to
 the bench's output folder (``--out``, default ``runs/bench``).
 """
 
@@ -221,11 +221,12 @@ def growth_curves(es, world, quick: bool, batches=BATCHES, scene_counts=SCENE_CO
 
 
 def plot_growth(rec: dict, path: str | os.PathLike) -> Path:
-    """``scaling.png``: one panel per curve (steps/s, and peak program memory on a second axis)."""
+    """``scaling.png``: one panel per curve (steps/s, and peak program memory on a second axis; x on a log scale)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import EngFormatter
 
     import io
 
@@ -245,14 +246,16 @@ def plot_growth(rec: dict, path: str | os.PathLike) -> Path:
         sps = [pts[v] if key == "devices" else pts[v]["steps_per_s"] for v in xs]
         ax.plot(x, sps, "o-", color="tab:blue", label="decision steps/s")
         ax.set_xscale("log", base=2)
-        ax.set_yscale("log")
+        ax.set_ylim(bottom=0)
         ax.set_xlabel(label)
         ax.set_ylabel("decision steps/s", color="tab:blue")
         ax.set_xticks(x, [str(int(v)) for v in x])
+        ax.yaxis.set_major_formatter(EngFormatter(sep=""))
         if key != "devices":
             ax2 = ax.twinx()
             ax2.plot(x, [pts[v]["memory_mb"]["peak"] for v in xs], "s--", color="tab:red", label="program memory")
-            ax2.set_yscale("log")
+            ax2.set_ylim(bottom=0)
+            ax2.yaxis.set_major_formatter(EngFormatter(sep=""))
             ax2.set_ylabel("peak program memory (MB)", color="tab:red")
         ax.grid(alpha=0.3, which="both")
     skipped = "; ".join(f"{k}: {v}" for k, v in rec.get("skipped", {}).items())
