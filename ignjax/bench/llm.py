@@ -10,8 +10,11 @@ request's hash) until the prompt says turn ``DECISIONS``, then stops, so
 every episode is ``DECISIONS`` decisions long.
 
 * ``batched``: the host loop (:mod:`ignjax.evaluate.hostloop`) with
-  ``concurrency`` episodes in flight and the client's concurrency equal to
-  the server's;
+  ``EPISODES_PER_SLOT`` x ``concurrency`` episodes in flight and the
+  client's concurrency equal to the server's: while a row is stepped,
+  rendered and encoded, another row's request is already queued for the
+  server slot its reply frees (with only ``concurrency`` episodes, every
+  host-side pause of a row leaves a server slot idle);
 * ``sequential``: the field's usual loop, one episode at a time and one
   blocking request per decision (the same host loop with one slot and one
   request in flight), on the first episodes only; episodes per hour
@@ -28,8 +31,12 @@ concurrency, over the whole run (compilation of the simulator's jitted
 pieces happens before the first request and is not counted in it, but is in
 the wall times). ``host_ms_per_decision``: the batched loop against a
 zero-latency server (observation, rendering, composition, encoding,
-request, parse, step), wall time per decision after a warm-up run. Both
-loops' programs are compiled before anything is timed.
+request, parse, step), wall time per decision of the batched run's
+episodes and batch. A zero-latency warm-up run of the batched
+run's own episodes and batch comes first, so both loops' programs are
+compiled and the render contexts of the batched run's scenes made
+(:class:`~ignjax.sim.views.contexts.SceneContexts` keeps them) before
+anything is timed.
 ``limited_by`` names what bounds the batched figure: the server's
 concurrency x latency, or the host (rendering and stepping) when its
 decisions per second stay below what the server could answer.
@@ -70,6 +77,8 @@ from concurrent.futures import ThreadPoolExecutor, wait
 from ignjax.bench.timing import log
 
 DECISIONS = 6
+EPISODES_PER_SLOT = 2
+"""Episodes in flight per server slot in the batched run (module docstring)."""
 VLLM_MAX_NUM_SEQS = 8
 VLLM_MAX_STEPS = 4
 """Decision budget of an episode against vLLM (episodes end there unless the model stops first)."""
@@ -132,19 +141,21 @@ def bench_llm(es, quick: bool, latency: float = 4.0, concurrency: int = 64) -> d
     n_batched = concurrency * (2 if quick else 4)
     n_seq = 1 if quick else 3
     batched_es = es.subset(range(min(n_batched, len(es))))
+    in_flight = EPISODES_PER_SLOT * concurrency
     out = {"concurrency": concurrency, "latency_s": latency, "views": sim.n_views, "size": views.size,
-           "decisions_per_episode": DECISIONS, "episodes": {"batched": len(batched_es), "sequential": n_seq}}
+           "decisions_per_episode": DECISIONS, "episodes": {"batched": len(batched_es), "sequential": n_seq},
+           "episodes_in_flight": {"batched": in_flight, "sequential": 1}}
     with _shared(es, sim, views) as shared:
-        # host cost per decision: zero-latency server, after a warm-up (compilation, render contexts)
+        # host cost per decision: zero-latency server, after a warm-up on the batched run's own episodes and
+        # batch (its programs compiled, the render contexts of its scenes made)
         with ScriptedServer(latency=0.0, concurrency=concurrency, policy=_policy) as srv:
-            warm = es.subset(range(min(concurrency, len(es))))
-            _run(warm, srv, concurrency, concurrency, views, sim, None, shared)
+            _run(batched_es, srv, in_flight, concurrency, views, sim, None, shared)
             _run(es.subset(range(1)), srv, 1, 1, views, sim, None, shared)  # the sequential loop's programs too
-            res, wall = _run(warm, srv, concurrency, concurrency, views, sim, None, shared)
+            res, wall = _run(batched_es, srv, in_flight, concurrency, views, sim, None, shared)
         out["host_ms_per_decision"] = 1000.0 * wall / max(1, res.stats["decisions"])
         log(f"  host {out['host_ms_per_decision']:.1f} ms a decision ({res.stats['decisions']} decisions, zero latency)")
         with ScriptedServer(latency=latency, jitter=0.25, concurrency=concurrency, policy=_policy) as srv:
-            res_b, wall_b = _run(batched_es, srv, concurrency, concurrency, views, sim, None, shared)
+            res_b, wall_b = _run(batched_es, srv, in_flight, concurrency, views, sim, None, shared)
             _, wall_s = _run(es.subset(range(n_seq)), srv, 1, 1, views, sim, None, shared)
     eph_b = 3600.0 * len(batched_es) / wall_b
     eph_s = 3600.0 * n_seq / wall_s

@@ -97,7 +97,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="have the model reword each oracle answer before the agent reads it (a rewording that breaks "
                         "the answer's rules is dropped for the template); same as --set llm.paraphrase=true")
     g.add_argument("--llm-concurrency", type=int, default=None, help="requests in flight per endpoint (default 16)")
-    g.add_argument("--llm-batch", type=int, default=64, help="episodes in flight at once (default 64)")
+    g.add_argument("--llm-batch", type=int, default=64, help="episodes in flight at once (default 64; keep it at least twice "
+                   "llm.concurrency x endpoints so every server slot has a request queued)")
     g.add_argument("--dry-run", action="store_true",
                    help="print what the MLLM agents would send (requests, images, estimated tokens and cost) and exit "
                         "without sending anything or loading scenes")

@@ -16,7 +16,10 @@ one episode. A round:
    (:class:`~ignjax.sim.views.ViewRenderer`) in a worker thread, one render
    at a time: while it runs, the loop keeps stepping the rows whose replies
    arrive, and the rows that become ready meanwhile are rendered together
-   in the next call. When a render finishes, one request per row is sent;
+   in the next call. A call takes at most half the client's capacity
+   (``concurrency`` x endpoints / 2 rows, oldest first), so at the start,
+   or when many rows become ready at once, the first requests leave while
+   the rest render. When a render finishes, one request per row is sent;
    all requests are in flight at once, bounded per endpoint by the client
    (:class:`~ignjax.agents.llm.client.ChatClient`);
 4. the loop wakes when any reply or render finishes and takes every reply
@@ -280,6 +283,7 @@ class HostLoop:
         E.check_specs(self.world, es.specs)
         self.n = len(es)
         self.B = max(1, min(int(batch), self.n))
+        self.render_rows = max(1, llm.concurrency * len(llm.endpoints) // 2)
         self.keys = episode_keys(seed, np.arange(self.n))
         self.names = self._view_names()
         self.categories = es.bank.categories
@@ -538,9 +542,10 @@ class HostLoop:
                         need = []
                     if waiting and render is None:
                         # rendered while the loop keeps stepping rows whose replies arrive; rows that become
-                        # ready meanwhile are rendered together in the next call
-                        render = loop.run_in_executor(None, self._decisions, waiting, slots)
-                        waiting = []
+                        # ready meanwhile are rendered together in the next call (at most render_rows a call,
+                        # oldest first, so the first requests leave while the rest render)
+                        render = loop.run_in_executor(None, self._decisions, waiting[:self.render_rows], slots)
+                        waiting = waiting[self.render_rows:]
                     if not tasks and render is None:
                         break
                     done, _ = await asyncio.wait(list(tasks) + ([render] if render is not None else []),

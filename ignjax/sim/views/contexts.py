@@ -20,7 +20,8 @@ pixels never depend on how many rows were pending when it was rendered."""
 
 class SceneContexts:
     """The backend's per-scene renderers, made on first use and kept in a
-    least-recently-used cache of ``config.max_contexts`` (closed when
+    least-recently-used cache of at most ``config.max_contexts`` renderers
+    whose warp output buffers stay under ``config.cache_mb`` (closed when
     dropped). Used in this process and, one each, in the render workers.
 
     Args:
@@ -31,6 +32,7 @@ class SceneContexts:
     def __init__(self, compiled, backend: str, sim: SimConfig, config: ViewConfig):
         self.compiled, self.backend, self.sim, self.config = compiled, backend, sim, config
         self._scenes: OrderedDict = OrderedDict()
+        self.made = 0  # renderers made so far (a cache too small for a run's groups shows here)
 
     def _scene(self, s: int, rows: int):
         cfg, sim = self.config, self.sim
@@ -42,7 +44,10 @@ class SceneContexts:
         if key in self._scenes:
             self._scenes.move_to_end(key)
             return self._scenes[key]
-        while len(self._scenes) >= cfg.max_contexts:
+        budget = cfg.cache_mb << 20
+        size = cfg.context_bytes(sim.n_views, key[1])
+        while self._scenes and (len(self._scenes) >= cfg.max_contexts
+                                or self._bytes() + size > budget):
             _, old = self._scenes.popitem(last=False)
             close = getattr(old, "close", None)
             if close:
@@ -57,7 +62,11 @@ class SceneContexts:
 
             r = WarpScene(compiled, sim.n_views, sim.hfov, sim.eye_height, cfg.size, key[1])
         self._scenes[key] = r
+        self.made += 1
         return r
+
+    def _bytes(self) -> int:
+        return sum(self.config.context_bytes(self.sim.n_views, k[1]) for k in self._scenes)
 
     def render(self, s: int, poses: np.ndarray):
         """(rgb, depth, instance) of the views of ``poses`` (R, 3) in scene

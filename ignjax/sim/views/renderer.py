@@ -8,9 +8,10 @@ group with the configured backend:
 * warp: one call per scene and chunk of up to ``ViewConfig.world_limit``
   rows. Contexts are made for power-of-two world counts (the smallest that
   holds the group, so a few pending rows do not pay for a full batch),
-  kept in a least-recently-used cache of ``max_contexts`` and reused across
-  steps; memory therefore grows with ``max_contexts`` x worlds x N x S^2 x
-  16 bytes, not with the scenes in the bank (:mod:`ignjax.sim.views.warp`).
+  kept in a least-recently-used cache whose output buffers (worlds x N x
+  S^2 x 16 bytes each) stay under ``cache_mb`` and reused across steps;
+  memory therefore grows with ``cache_mb``, not with the scenes in the
+  bank (:mod:`ignjax.sim.views.warp`).
 * egl: one OpenGL context per scene (a few MB each), one view at a time.
 * with ``ViewConfig.workers`` > 1 the calls go to that many worker
   processes (:mod:`ignjax.sim.views.pool`), each with its own contexts.

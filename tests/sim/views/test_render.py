@@ -150,6 +150,24 @@ def test_view_count_and_determinism(house, backend):
     assert np.array_equal(a.rgb[0], c.rgb[1]) and np.array_equal(a.depth[0], c.depth[1])
 
 
+def test_context_cache_keeps_what_fits_its_budget(house):
+    """Warp contexts are kept while their output buffers fit ``cache_mb``:
+    a 2-world and a 4-world context of one scene at 120 px (3.7 and 7.4 MB)
+    are made once each under 16 MB, and the 2-world one again under 8 MB."""
+    bank, poses = house
+    if warp_available():
+        pytest.skip(warp_available())
+    cfg = ViewConfig(size=SIZE, backend="warp", fallback=False)
+    assert cfg.context_bytes(8, 2) == 2 * 8 * SIZE * SIZE * 16
+    made = {}
+    for mb in (16, 8):
+        with ViewRenderer(bank, T.SimConfig(), cfg.replace(cache_mb=mb)) as r:
+            for rows in (2, 3, 2):
+                r.render(np.zeros(rows, int), poses[:rows])
+            made[mb] = r._contexts.made
+    assert made == {16: 2, 8: 3}
+
+
 def test_bad_inputs(house):
     bank, poses = house
     for kw, field in ((dict(size=32), "views.size"), (dict(size=2048), "views.size"),
