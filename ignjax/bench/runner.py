@@ -23,6 +23,13 @@ process, on the same inputs:
   1, 2 and all devices (``scaling.devices``), measured after compile in
   turns (best of three each), so a machine shared with other work slows
   them alike.
+* **limit** - what this machine allows the same rollouts at B = 4096
+  (:mod:`ignjax.bench.limit`): its gather rates, read bandwidth and
+  elementwise rate, each agent's look-ups and operations per decision step
+  counted in its own program, the steps/s they allow, what bounds them
+  (``"gather"``, ``"bandwidth"`` or ``"compute"``) and the fraction of it
+  the decision-steps figure reaches; the top-level ``steps_per_s``,
+  ``bound`` and ``fraction`` are the EIG agent's.
 * **compile_s** - first call of the EIG agent's rollout at B = 256.
 * **studies** - offline WSR of 10^6 cost vectors x 500 episodes, and the
   in-the-loop sweep (the EIG agent under K cost vectors x 500 episodes in
@@ -67,6 +74,7 @@ def main(argv=None) -> int:
     # simulator (about 5 s), which ``--help`` should not wait for
     import jax
 
+    from ignjax.bench.limit import LIMIT_BATCH, bench_limit
     from ignjax.bench.rays import bench_probe_rays, bench_rays
     from ignjax.bench.render import bench_render
     from ignjax.bench.rollouts import AGENTS, bench_steps, bench_studies
@@ -117,6 +125,8 @@ def main(argv=None) -> int:
     log(f"  each batch sharded over {batch_parts()} {jax.default_backend()} devices")
     res["steps_per_s"], res["compile_s"] = bench_steps(es, world, agents, sizes)
     log(f"  EIG rollout compile {res['compile_s']:.1f} s")
+    log(f"what the machine allows a decision step (B = {LIMIT_BATCH}) ...")
+    res["limit"] = bench_limit(es, world, agents, LIMIT_BATCH, res["steps_per_s"], args.quick)
     res["scaling"] = _scaling(es, world)
     log("studies ...")
     res["studies"] = bench_studies(es, world, args.quick)

@@ -28,7 +28,7 @@ STUDY_KEYS = {"offline_wsr_1e6_x_500_s", "in_loop_vectors", "in_loop_episodes", 
               "in_loop_episodes_per_s"}
 TOP_KEYS = {"device", "quick", "n_rays", "ngeom", "rays_per_s", "ray_agreement", "ray_agreement_depth_march",
             "scene_compile_s", "speedup_vs_mjx", "speedup_vs_multiray", "probe_ray_agreement", "rollout_parts",
-            "steps_per_s", "compile_s", "studies"}
+            "steps_per_s", "compile_s", "studies", "limit"}
 SIZES = ("256", "1024", "4096")
 
 
@@ -69,6 +69,12 @@ def check_record(res: dict) -> None:
     assert all(isinstance(v, int) and v >= 1 for v in res["rollout_parts"].values())
     check_steps(res["steps_per_s"], ("random", "eig"), SIZES)  # --quick: the EIG and random agents only
     assert isinstance(res["compile_s"], float) and math.isfinite(res["compile_s"])
+    lim = res["limit"]
+    assert lim["bound"] in ("gather", "bandwidth", "compute") and _positive(lim["steps_per_s"])
+    assert set(lim["agents"]) == {"random", "eig"} and lim["batch"] == 4096
+    for name, a in lim["agents"].items():
+        assert _positive(a["fraction"]) and _positive(a["work"]["gather_world"]), (name, a)
+    assert all(_positive(v) for v in lim["rates"].values()), lim["rates"]
     s = res["studies"]
     assert set(s) == STUDY_KEYS
     assert s["in_loop_vectors"] == 16 and s["in_loop_episodes"] == 500  # --quick: K = 16
