@@ -55,6 +55,36 @@ def test_episodes_two_workers_write_the_same_bytes(houses):
     assert warn[0] == warn[1]
 
 
+def _stage_with_warnings(path):
+    """A stage whose import warns (unresolved sublayer and references) and
+    whose one room has no navigable cell (a warning of the build)."""
+    from pxr import Gf, Usd, UsdGeom
+
+    st = Usd.Stage.CreateNew(str(path))
+    UsdGeom.SetStageUpAxis(st, "Z")
+    st.SetDefaultPrim(UsdGeom.Xform.Define(st, "/World").GetPrim())
+    st.GetRootLayer().subLayerPaths.append("./gone_layer.usda")
+    UsdGeom.Cube.Define(st, "/World/Stool").AddTranslateOp().Set(Gf.Vec3d(0.0, 0.0, 1.0))
+    for k in range(2):
+        UsdGeom.Xform.Define(st, f"/World/Lamp_{k}").GetPrim().GetReferences().AddReference(f"./gone_{k}.mtlx")
+    st.Save()
+    return path
+
+
+def test_episodes_workers_warn_like_serial(tmp_path, houses):
+    """Warnings raised in the workers (reading a scene, building its episodes)
+    are printed by the command in scene order, as the serial run prints them."""
+    odd = _stage_with_warnings(tmp_path / "busy.usda")
+    procs = {}
+    for n in (1, 2):
+        procs[n] = run_build("episodes", "--scenes", odd, houses["files"][2], "--out", tmp_path / f"e{n}" / "e.jsonl.gz",
+                             "--subset", 5, "--starts", 1, "--workers", n, "--quiet")
+        assert procs[n].returncode == 0, procs[n].stderr
+    assert "could not be resolved" in procs[1].stderr and "warning: scene busy:" in procs[1].stderr
+    assert procs[1].stderr == procs[2].stderr
+    assert listing(tmp_path / "e1") == listing(tmp_path / "e2")
+
+
 @pytest.mark.parametrize("command", ["scenes", "episodes"])
 @pytest.mark.parametrize("value", ["-1", "two"])
 def test_bad_workers_is_one_clear_line(tmp_path, houses, command, value):

@@ -18,6 +18,7 @@ from __future__ import annotations
 import gzip
 import json
 import os
+import warnings
 from pathlib import Path
 from types import MappingProxyType
 
@@ -120,11 +121,27 @@ def scene_sources(paths, map_=map) -> list[tuple[object, Path]]:
             error = e
             break
     out = []
-    for f, scenes in zip(files, map_(load_scenes, files)):
-        out += [(s, f) for s in scenes]
+    if map_ is map:
+        for f, scenes in zip(files, map(load_scenes, files)):
+            out += [(s, f) for s in scenes]
+    else:
+        for f, (scenes, caught) in zip(files, map_(_load_recorded, files)):
+            for category, message in caught:  # raised here, in file order, as if read here
+                warnings.warn(message, category, stacklevel=2)
+            out += [(s, f) for s in scenes]
     if error is not None:
         raise error
     return out
+
+
+def _load_recorded(path: Path) -> tuple[list[Scene], list]:
+    """:func:`load_scenes` plus the warnings it raised, as ``(category,
+    message)`` pairs (the unit of work of :func:`scene_sources` in another
+    process)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        scenes = load_scenes(path)
+    return scenes, [(w.category, str(w.message)) for w in caught]
 
 
 # Readers, one per kind of source. Each imports its library when a file of its
