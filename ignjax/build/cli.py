@@ -98,8 +98,11 @@ def _scenes_parallel(args, params, workers: int, out: Path) -> list[dict]:
     """The houses of ``scenes`` built by ``workers`` processes; same files as
     the serial loop of :func:`cmd_scenes`. Each house is written into a
     staging folder inside ``out`` and moved into place in house order, so a
-    failure at house k leaves what the serial loop leaves (houses before k,
-    no manifest) and the error is house k's own."""
+    house that fails its check, its USD file or its map leaves what the serial
+    loop leaves (the houses before it, no manifest) and the error is its own.
+    (A house the generator itself fails on, which valid parameters do not
+    give, is reported the same way; the serial loop reports it before writing
+    anything.)"""
     # imported on use, so that --help and the other commands answer at once
     from ignjax.build.pool import ordered_map
     from ignjax.scenes.procgen import generate as procgen
@@ -112,7 +115,7 @@ def _scenes_parallel(args, params, workers: int, out: Path) -> list[dict]:
     try:
         with ordered_map(workers, len(tasks)) as map_:
             results = map_(_house_task, tasks)
-            for (_, _, scene_id), _ in zip(plan, _progress(range(len(plan)), len(plan), "houses", args.quiet)):
+            for _, _, scene_id in _progress(plan, len(plan), "houses", args.quiet):
                 try:
                     entry = next(results)
                 except BaseException:
