@@ -29,6 +29,11 @@ class InputError(IgnjaxError, ValueError):
         parts = [p for p in (self.path, self.where) if p]
         super().__init__(": ".join(parts + [reason]))
 
+    def __reduce__(self):
+        # pickled by its fields, so that it crosses process boundaries (a
+        # worker of ``--workers N``) as the same error
+        return type(self), (self.path or None, self.where or None, self.reason), self.__dict__
+
 
 class SceneError(InputError):
     """A scene source cannot be turned into a valid :class:`Scene`."""

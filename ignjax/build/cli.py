@@ -2,14 +2,18 @@
 
 Sub-commands::
 
-    python -m ignjax.build scenes --out DIR [--count N] [--seed S] [--maps]
+    python -m ignjax.build scenes --out DIR [--count N] [--seed S] [--maps] [--workers N]
     python -m ignjax.build inspect PATH [--json]
-    python -m ignjax.build episodes --scenes PATH... --out FILE.jsonl.gz [--subset N] [--seed S] [--alpha a1,a2,a3,a4]
+    python -m ignjax.build episodes --scenes PATH... --out FILE.jsonl.gz [--subset N] [--seed S] [--alpha a1,a2,a3,a4] [--workers N]
     python -m ignjax.build episodes --check FILE
 
 Errors on bad input are printed as one line naming the file, the place in it
 and the reason, and the command exits with status 2 without writing
 half-finished outputs.
+
+``--workers N`` (``scenes`` and ``episodes``) does the per-scene work in N
+processes (0: one per CPU core; :mod:`ignjax.build.pool`); the files written
+and the errors raised are the same as with the default of one.
 
 ``inspect PATH --json`` prints exactly one JSON object on stdout: for one
 scene ``{"source", "scene_id", "format", "up_axis", "meters_per_unit",
@@ -32,7 +36,10 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
+import shutil
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -46,18 +53,98 @@ def _progress(iterable, total: int, desc: str, quiet: bool):
     return tqdm(iterable, total=total, desc=desc, disable=quiet, file=sys.stderr, dynamic_ncols=True)
 
 
+def _house_task(task: tuple) -> dict:
+    """One house of ``scenes --workers N`` (in a worker process): generate it,
+    check it, write its USD file (and map) into the staging folder; returns
+    its manifest entry."""
+    # imported on use, so that --help and the other commands answer at once
+    from ignjax.scenes.procgen import generate as procgen
+    from ignjax.scenes.io.manifest import manifest_entry
+    from ignjax.scenes.io.usd import save_usd
+
+    seed, params, scene_id, staging, check, maps = task
+    scene = procgen.generate_house(seed, params, scene_id)
+    if check:
+        # imported on use, so that --help and the other commands answer at once
+        from ignjax.scenes.compile import compile_scene
+        from ignjax.scenes.navgrid import GridConfig, build_navgrid, check_reachable
+
+        grid = build_navgrid(compile_scene(scene), GridConfig())
+        check_reachable(scene, grid, scene.id)
+    entry = manifest_entry(scene, save_usd(scene, Path(staging) / f"{scene.id}.usda"))
+    if maps:
+        # imported on use, so that --help and the other commands answer at once
+        from ignjax.scenes.viz.mapplot import plot_scene_map
+
+        plot_scene_map(scene, Path(staging) / "maps" / f"{scene.id}.png")
+    return entry
+
+
+def _move_staged(staging: Path, out: Path, scene_id: str) -> None:
+    """Move a house's files from the staging folder to their place in ``out``
+    (renames within one file system: each file appears whole)."""
+    for rel in (f"{scene_id}.usda", f"maps/{scene_id}.png"):
+        src, dst = staging / rel, out / rel
+        if not src.exists():
+            continue
+        try:
+            dst.parent.mkdir(exist_ok=True)
+            os.replace(src, dst)
+        except OSError as e:
+            raise SceneError(dst, None, f"cannot write: {e}") from e
+
+
+def _scenes_parallel(args, params, workers: int, out: Path) -> list[dict]:
+    """The houses of ``scenes`` built by ``workers`` processes; same files as
+    the serial loop of :func:`cmd_scenes`. Each house is written into a
+    staging folder inside ``out`` and moved into place in house order, so a
+    house that fails its check, its USD file or its map leaves what the serial
+    loop leaves (the houses before it, no manifest) and the error is its own.
+    (A house the generator itself fails on, which valid parameters do not
+    give, is reported the same way; the serial loop reports it before writing
+    anything.)"""
+    # imported on use, so that --help and the other commands answer at once
+    from ignjax.build.pool import ordered_map
+    from ignjax.scenes.procgen import generate as procgen
+
+    plan = procgen.house_plan(args.count, args.seed, params)  # validates count and seed before anything is written
+    out.mkdir(parents=True, exist_ok=True)
+    staging = Path(tempfile.mkdtemp(prefix=".staging-", dir=out))
+    tasks = [(s_i, p_i, scene_id, str(staging), args.check, args.maps) for s_i, p_i, scene_id in plan]
+    entries = []
+    try:
+        with ordered_map(workers, len(tasks)) as map_:
+            results = map_(_house_task, tasks)
+            for _, _, scene_id in _progress(plan, len(plan), "houses", args.quiet):
+                try:
+                    entry = next(results)
+                except BaseException:
+                    _move_staged(staging, out, scene_id)  # what the serial loop had written of this house
+                    raise
+                _move_staged(staging, out, scene_id)
+                entries.append(entry)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    return entries
+
+
 def cmd_scenes(args) -> int:
     """Generate procedural houses, write them as USD plus a manifest."""
     # imported on use, so that --help and the other commands answer at once
+    from ignjax.build.pool import resolve_workers
     from ignjax.scenes.procgen import generate as procgen
-    from ignjax.scenes.io.manifest import manifest_entry, write_manifest
+    from ignjax.scenes.io.manifest import manifest_entry
     from ignjax.scenes.io.usd import save_usd
 
+    workers = resolve_workers(args.workers)
     params = procgen.HouseParams(min_rooms=args.min_rooms, max_rooms=args.max_rooms)
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise ConfigError(out, "--out", "exists and is not a folder")
     t0 = time.perf_counter()
+    if workers > 1:
+        entries = _scenes_parallel(args, params, workers, out)
+        return _scenes_done(args, params, out, entries, t0)
     scenes = procgen.generate_houses(args.count, args.seed, params)  # validates count and seed before anything is written
     out.mkdir(parents=True, exist_ok=True)
     entries = []
@@ -77,6 +164,13 @@ def cmd_scenes(args) -> int:
 
             (out / "maps").mkdir(exist_ok=True)
             plot_scene_map(scene, out / "maps" / f"{scene.id}.png")
+    return _scenes_done(args, params, out, entries, t0)
+
+
+def _scenes_done(args, params, out: Path, entries: list[dict], t0: float) -> int:
+    # imported on use, so that --help and the other commands answer at once
+    from ignjax.scenes.io.manifest import write_manifest
+
     write_manifest(out, entries, {"seed": args.seed, "count": args.count, "params": params.to_dict()})
     total = sum(e["instances"] for e in entries)
     print(f"wrote {len(entries)} houses ({sum(e['rooms'] for e in entries)} rooms, {total} instances) "
@@ -205,6 +299,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--maps", action="store_true", help="also write a top-down map PNG per house into OUT/maps/")
     s.add_argument("--no-check", dest="check", action="store_false",
                    help="skip compiling each house and checking that every room is reachable")
+    s.add_argument("--workers", type=int, default=1,
+                   help="processes that build houses in parallel (default 1: this process; 0: one per CPU core); "
+                        "the files are the same for any number")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.set_defaults(func=cmd_scenes)
 
@@ -237,6 +334,9 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("--check", metavar="FILE", help="validate an episode file (against its scenes too) and print its counts")
     e.add_argument("--schema-only", action="store_true", help="with --check: validate the records only, not against the scenes")
     e.add_argument("--figure", help="where to draw the statistics figure (default: next to --out)")
+    e.add_argument("--workers", type=int, default=1,
+                   help="processes that load scenes and build their episodes in parallel (default 1: this process; "
+                        "0: one per CPU core); the files are the same for any number")
     e.add_argument("--quiet", action="store_true", help="no progress bar")
     e.set_defaults(func=cmd_episodes)
     return p

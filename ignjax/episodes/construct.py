@@ -338,7 +338,30 @@ def select_subset(records: list[dict], n: int, proportions=(0.3, 0.4, 0.3), seed
     return sorted(chosen), {"quota": quota, "short": short}
 
 
-def build_benchmark(scenes: list[tuple[Scene, str]], config: BuildConfig = BuildConfig(), progress=None):
+def scene_task(task: tuple[Scene, BuildConfig, str]) -> tuple[list[dict], list[dict], SceneReport, list]:
+    """:func:`scene_episodes` of one ``(scene, config, scene_file)`` plus the
+    warnings it raised as ``(category, message)`` pairs: the unit of work of
+    :func:`build_benchmark` when it runs in another process."""
+    scene, config, scene_file = task
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        r, c, rep = scene_episodes(scene, config, scene_file)
+    return r, c, rep, [(w.category, str(w.message)) for w in caught]
+
+
+def _mapped_episodes(scenes, config: BuildConfig, map_, progress):
+    """(scene, released, construction, report) per scene, in scene order, computed by
+    ``map_`` (a process pool's map); the scenes' warnings are raised here
+    again in scene order."""
+    it = progress(scenes) if progress else scenes
+    results = map_(scene_task, [(scene, config, scene_file) for scene, scene_file in scenes])
+    for (scene, _), (r, c, rep, caught) in zip(it, results):
+        for category, message in caught:
+            warnings.warn(message, category, stacklevel=3)
+        yield scene, r, c, rep
+
+
+def build_benchmark(scenes: list[tuple[Scene, str]], config: BuildConfig = BuildConfig(), progress=None, map_=None):
     """Build the whole corpus and the evaluation subset.
 
     Args:
@@ -346,6 +369,10 @@ def build_benchmark(scenes: list[tuple[Scene, str]], config: BuildConfig = Build
             records so evaluations can find the scene again.
         config: construction options.
         progress: optional callable wrapping an iterable (a progress bar).
+        map_: optional ``map_(fn, items)`` returning results in item order,
+            such as a process pool's (:func:`ignjax.build.pool.ordered_map`):
+            the scenes' episodes are then built by it. Each scene's episodes
+            depend on (seed, scene) alone, so the result is the same.
 
     Returns:
         dict with ``corpus`` / ``corpus_construction`` (all episodes),
@@ -357,9 +384,12 @@ def build_benchmark(scenes: list[tuple[Scene, str]], config: BuildConfig = Build
     if dup:
         raise SceneError(None, "scenes", f"scene ids must be unique across the sources; repeated: {dup}")
     corpus, corpus_c, reports = [], [], []
-    it = progress(scenes) if progress else scenes
-    for scene, scene_file in it:
-        r, c, rep = scene_episodes(scene, config, scene_file)
+    if map_ is None:
+        it = progress(scenes) if progress else scenes
+        per_scene = ((scene, *scene_episodes(scene, config, scene_file)) for scene, scene_file in it)
+    else:
+        per_scene = _mapped_episodes(scenes, config, map_, progress)
+    for scene, r, c, rep in per_scene:
         if rep.skipped:
             warnings.warn(f"scene {scene.id}: skipped ({rep.skipped})", stacklevel=2)
         if rep.unreachable_rooms:

@@ -18,6 +18,7 @@ from __future__ import annotations
 import gzip
 import json
 import os
+import warnings
 from pathlib import Path
 from types import MappingProxyType
 
@@ -88,24 +89,59 @@ def _json_document(p: Path):
         raise SceneError(p, None, f"cannot read: {e}") from e
 
 
-def scene_sources(paths) -> list[tuple[object, Path]]:
-    """(scene, file) pairs for every scene in the given sources."""
-    out = []
+def _source_files(raw) -> list[Path]:
+    """The scene files of one source given to :func:`scene_sources`."""
+    p = Path(raw)
+    if not p.exists():
+        raise SceneError(p, None, "no such file or directory")
+    if p.is_dir():
+        manifest = p / "manifest.json"
+        files = [p / e["file"] for e in read_manifest(manifest)] if manifest.exists() else sorted(
+            f for f in p.iterdir() if f.is_file() and is_scene_file(f) and not f.name.endswith(SIDECAR_SUFFIX))
+        if not files:
+            raise SceneError(p, None, "the directory holds no scene files")
+        return files
+    return [p]
+
+
+def scene_sources(paths, map_=map) -> list[tuple[object, Path]]:
+    """(scene, file) pairs for every scene in the given sources.
+
+    ``map_`` reads the files (``map_(load_scenes, files)``, results in file
+    order): the built-in :func:`map` reads them one by one here, a process
+    pool's map (:func:`ignjax.build.pool.ordered_map`) in parallel. Either way
+    the error raised is the one reading the sources in order meets first.
+    """
+    files: list[Path] = []
+    error: BaseException | None = None
     for raw in paths:
-        p = Path(raw)
-        if not p.exists():
-            raise SceneError(p, None, "no such file or directory")
-        if p.is_dir():
-            manifest = p / "manifest.json"
-            files = [p / e["file"] for e in read_manifest(manifest)] if manifest.exists() else sorted(
-                f for f in p.iterdir() if f.is_file() and is_scene_file(f) and not f.name.endswith(SIDECAR_SUFFIX))
-            if not files:
-                raise SceneError(p, None, "the directory holds no scene files")
-        else:
-            files = [p]
-        for f in files:
-            out += [(s, f) for s in load_scenes(f)]
+        try:
+            files += _source_files(raw)
+        except Exception as e:  # raised once the files of the sources before it are read, as reading in order would
+            error = e
+            break
+    out = []
+    if map_ is map:
+        for f, scenes in zip(files, map(load_scenes, files)):
+            out += [(s, f) for s in scenes]
+    else:
+        for f, (scenes, caught) in zip(files, map_(_load_recorded, files)):
+            for category, message in caught:  # raised here, in file order, as if read here
+                warnings.warn(message, category, stacklevel=2)
+            out += [(s, f) for s in scenes]
+    if error is not None:
+        raise error
     return out
+
+
+def _load_recorded(path: Path) -> tuple[list[Scene], list]:
+    """:func:`load_scenes` plus the warnings it raised, as ``(category,
+    message)`` pairs (the unit of work of :func:`scene_sources` in another
+    process)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        scenes = load_scenes(path)
+    return scenes, [(w.category, str(w.message)) for w in caught]
 
 
 # Readers, one per kind of source. Each imports its library when a file of its

@@ -2,7 +2,8 @@
 
 :func:`generate_house` turns a seed and :class:`HouseParams` into a
 :class:`~ignjax.scenes.model.Scene`; :func:`generate_houses` makes a set of
-houses of varied sizes. Everything random comes from numpy generators derived
+houses of varied sizes (:func:`house_plan` gives each house's seed, parameters
+and id without generating it). Everything random comes from numpy generators derived
 from the seed, so the same seed and parameters give equal scenes (``==``).
 
 The work is split by idea: :mod:`~ignjax.scenes.procgen.params` (the
@@ -35,7 +36,7 @@ from ignjax.scenes.procgen.furnish import furnish
 from ignjax.scenes.procgen.layout import layout_rooms, make_doors, make_walls, room_program
 from ignjax.scenes.procgen.params import HouseParams
 
-__all__ = ["generate_house", "generate_houses", "house_info"]
+__all__ = ["generate_house", "generate_houses", "house_info", "house_plan"]
 
 
 def house_info(scene: Scene) -> dict[str, Any]:
@@ -131,6 +132,19 @@ def generate_houses(count: int, seed: int, params: HouseParams = HouseParams(), 
     Returns:
         The houses, in order.
     """
+    return [generate_house(s_i, p_i, scene_id, catalogue=catalogue)
+            for s_i, p_i, scene_id in house_plan(count, seed, params)]
+
+
+def house_plan(count: int, seed: int, params: HouseParams = HouseParams()) -> list[tuple[int, HouseParams, str]]:
+    """The ``(seed, params, scene_id)`` of each house :func:`generate_houses`
+    makes, in order, without generating any: house ``i`` is
+    ``generate_house(*plan[i])``, independent of the other houses, so the
+    houses can be generated in any order or in separate processes.
+
+    Raises:
+        ConfigError: ``count`` or ``seed`` is not a non-negative integer.
+    """
     seed = _check_seed(seed)
     if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 0:
         raise ConfigError(None, "count", f"must be a non-negative integer, got {count!r}")
@@ -145,6 +159,5 @@ def generate_houses(count: int, seed: int, params: HouseParams = HouseParams(), 
     out = []
     for i in range(count):
         s_i = int(np.random.SeedSequence([seed, i]).generate_state(1, np.uint32)[0])
-        p_i = dataclasses.replace(params, n_rooms=sizes[i])
-        out.append(generate_house(s_i, p_i, f"house_{seed}_{i:03d}", catalogue=catalogue))
+        out.append((s_i, dataclasses.replace(params, n_rooms=sizes[i]), f"house_{seed}_{i:03d}"))
     return out
