@@ -152,12 +152,19 @@ def _primitive(e, iv, counts: _Counts):
         cc, bc, carry = iv[:cn], iv[cn:cn + bn], iv[cn + bn:]
 
         def cond(state):
-            return _counted(prm["cond_jaxpr"], cc + list(state[0]))[0][0]
+            # a vmapped loop whose test differs between lanes keeps a batched test (its lowering reduces it)
+            return jnp.any(_counted(prm["cond_jaxpr"], cc + list(state[0]))[0][0])
 
         def body(state):
             carry, k = state
-            _, kc = _counted(prm["cond_jaxpr"], cc + list(carry))  # the test that let this iteration run
+            (pred,), kc = _counted(prm["cond_jaxpr"], cc + list(carry))  # the test that let this iteration run
             outs, kb = _counted(prm["body_jaxpr"], bc + list(carry))
+            if jnp.ndim(pred):
+                # a batched test (vmap): as JAX lowers it, lanes whose test is false keep their carry, one
+                # select per element of every carry
+                outs = [jnp.where(jnp.reshape(pred, jnp.shape(pred) + (1,) * (jnp.ndim(o) - jnp.ndim(pred))), o, c)
+                        for o, c in zip(outs, carry)]
+                kb = kb.at[COUNTERS.index("elementwise")].add(float(sum(math.prod(jnp.shape(o)) for o in outs)))
             return tuple(outs), k + kb + kc
 
         out, k = jax.lax.while_loop(cond, body, (tuple(carry), jnp.zeros(len(COUNTERS), jnp.float32)))

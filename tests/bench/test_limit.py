@@ -42,6 +42,21 @@ def test_counts_follow_loops_as_they_run():
         assert k["scatter_rows"] == 0
 
 
+def test_counts_of_a_vmapped_loop_run_to_its_longest_lane():
+    """A loop vmapped over lanes with different trip counts runs until the
+    longest lane is done, every lane's operations each time (the masked
+    lanes' work counts: it is the program's)."""
+    def f(n):
+        return jax.lax.while_loop(lambda c: c[0] < n, lambda c: (c[0] + 1, c[1] * 3), (jnp.int32(0), jnp.int32(1)))[1]
+
+    n = jnp.array([0, 2, 5, 1], jnp.int32)
+    out, k = _counts(jax.vmap(f), n)
+    assert np.array_equal(out, 3 ** np.asarray(n))
+    # 5 rounds, every lane: the test's compare (counted once a round, as in the unbatched loop: the test that let
+    # the round run), the body's add and multiply, a select for each of the 2 carries
+    assert k["elementwise"] == 5 * 4 * (1 + 2 + 2), k
+
+
 def test_counts_through_scan_cond_and_dot():
     table = jnp.arange(32, dtype=jnp.float32)
 
