@@ -296,7 +296,9 @@ def test_concurrent_requests_are_batched(vllm_server):
     rest waiting). Read from the server, not inferred from timings."""
 
     def body(seed: int) -> dict:
-        return chat_body(vllm_server, n_images=2, max_tokens=64, ignore_eos=True, seed=seed)
+        # 512 tokens each: long enough that the 8 stay in flight together even when a loaded machine's HTTP
+        # front end admits them one by one (at 64 tokens, a request could finish before the next arrived)
+        return chat_body(vllm_server, n_images=2, max_tokens=512, ignore_eos=True, seed=seed)
 
     ok_chat(vllm_server, body(0))  # warm-up
     assert _running(vllm_server) == 0
@@ -308,5 +310,5 @@ def test_concurrent_requests_are_batched(vllm_server):
         results = [f.result() for f in futures]
     for status, resp, _ in results:
         assert status == 200, resp
-        assert resp["usage"]["completion_tokens"] == 64
+        assert resp["usage"]["completion_tokens"] == 512
     assert max(seen) >= 2, f"running requests seen while 8 were in flight: {sorted(set(seen))}"
