@@ -45,3 +45,24 @@ class EpisodeError(InputError):
 
 class ConfigError(InputError):
     """A configuration value, TOML file or command-line option is invalid."""
+
+
+def call_recording_warnings(fn, *args):
+    """``(fn(*args), warnings)``: the warnings the call raised, as
+    ``(category, message)`` pairs that cross process boundaries (the unit
+    of work of a worker process, whose warnings :func:`warn_again` raises
+    in the parent)."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = fn(*args)
+    return result, [(w.category, str(w.message)) for w in caught]
+
+
+def warn_again(caught, stacklevel: int = 3) -> None:
+    """Raise the ``(category, message)`` pairs of :func:`call_recording_warnings` here, in order."""
+    import warnings
+
+    for category, message in caught:
+        warnings.warn(message, category, stacklevel=stacklevel)

@@ -53,17 +53,13 @@ def _progress(iterable, total: int, desc: str, quiet: bool):
     return tqdm(iterable, total=total, desc=desc, disable=quiet, file=sys.stderr, dynamic_ncols=True)
 
 
-def _house_task(task: tuple) -> dict:
-    """One house of ``scenes --workers N`` (in a worker process): generate it,
-    check it, write its USD file (and map) into the staging folder; returns
-    its manifest entry."""
+def _write_house(scene, folder: Path, check: bool, maps: bool) -> dict:
+    """Check a house (unless ``check`` is false), write its USD file (and
+    map) into ``folder``; returns its manifest entry."""
     # imported on use, so that --help and the other commands answer at once
-    from ignjax.scenes.procgen import generate as procgen
     from ignjax.scenes.io.manifest import manifest_entry
     from ignjax.scenes.io.usd import save_usd
 
-    seed, params, scene_id, staging, check, maps = task
-    scene = procgen.generate_house(seed, params, scene_id)
     if check:
         # imported on use, so that --help and the other commands answer at once
         from ignjax.scenes.compile import compile_scene
@@ -71,13 +67,24 @@ def _house_task(task: tuple) -> dict:
 
         grid = build_navgrid(compile_scene(scene), GridConfig())
         check_reachable(scene, grid, scene.id)
-    entry = manifest_entry(scene, save_usd(scene, Path(staging) / f"{scene.id}.usda"))
+    entry = manifest_entry(scene, save_usd(scene, folder / f"{scene.id}.usda"))
     if maps:
         # imported on use, so that --help and the other commands answer at once
         from ignjax.scenes.viz.mapplot import plot_scene_map
 
-        plot_scene_map(scene, Path(staging) / "maps" / f"{scene.id}.png")
+        (folder / "maps").mkdir(exist_ok=True)
+        plot_scene_map(scene, folder / "maps" / f"{scene.id}.png")
     return entry
+
+
+def _house_task(task: tuple) -> dict:
+    """One house of ``scenes --workers N`` (in a worker process): generate it
+    and :func:`_write_house` it into the staging folder."""
+    # imported on use, so that --help and the other commands answer at once
+    from ignjax.scenes.procgen import generate as procgen
+
+    seed, params, scene_id, staging, check, maps = task
+    return _write_house(procgen.generate_house(seed, params, scene_id), Path(staging), check, maps)
 
 
 def _move_staged(staging: Path, out: Path, scene_id: str) -> None:
@@ -133,8 +140,6 @@ def cmd_scenes(args) -> int:
     # imported on use, so that --help and the other commands answer at once
     from ignjax.build.pool import resolve_workers
     from ignjax.scenes.procgen import generate as procgen
-    from ignjax.scenes.io.manifest import manifest_entry
-    from ignjax.scenes.io.usd import save_usd
 
     workers = resolve_workers(args.workers)
     params = procgen.HouseParams(min_rooms=args.min_rooms, max_rooms=args.max_rooms)
@@ -149,21 +154,7 @@ def cmd_scenes(args) -> int:
     out.mkdir(parents=True, exist_ok=True)
     entries = []
     for scene in _progress(scenes, len(scenes), "houses", args.quiet):
-        if args.check:
-            # imported on use, so that --help and the other commands answer at once
-            from ignjax.scenes.compile import compile_scene
-            from ignjax.scenes.navgrid import GridConfig, build_navgrid, check_reachable
-
-            grid = build_navgrid(compile_scene(scene), GridConfig())
-            check_reachable(scene, grid, scene.id)
-        path = save_usd(scene, out / f"{scene.id}.usda")
-        entries.append(manifest_entry(scene, path))
-        if args.maps:
-            # imported on use, so that --help and the other commands answer at once
-            from ignjax.scenes.viz.mapplot import plot_scene_map
-
-            (out / "maps").mkdir(exist_ok=True)
-            plot_scene_map(scene, out / "maps" / f"{scene.id}.png")
+        entries.append(_write_house(scene, out, args.check, args.maps))
     return _scenes_done(args, params, out, entries, t0)
 
 

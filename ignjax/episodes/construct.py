@@ -51,7 +51,7 @@ from ignjax.episodes.difficulty import (
 )
 from ignjax.episodes.inventory import InventoryConfig, build_inventory
 from ignjax.episodes.schema import SCHEMA, CONSTRUCTION_SCHEMA, VERSION
-from ignjax.errors import ConfigError, SceneError
+from ignjax.errors import ConfigError, SceneError, call_recording_warnings, warn_again
 from ignjax.scenes.compile import CompiledScene, compile_scene
 from ignjax.scenes.geodesic import goal_fields
 from ignjax.scenes.model import Scene
@@ -342,11 +342,8 @@ def scene_task(task: tuple[Scene, BuildConfig, str]) -> tuple[list[dict], list[d
     """:func:`scene_episodes` of one ``(scene, config, scene_file)`` plus the
     warnings it raised as ``(category, message)`` pairs: the unit of work of
     :func:`build_benchmark` when it runs in another process."""
-    scene, config, scene_file = task
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        r, c, rep = scene_episodes(scene, config, scene_file)
-    return r, c, rep, [(w.category, str(w.message)) for w in caught]
+    (r, c, rep), caught = call_recording_warnings(scene_episodes, *task)
+    return r, c, rep, caught
 
 
 def _mapped_episodes(scenes, config: BuildConfig, map_, progress):
@@ -356,8 +353,7 @@ def _mapped_episodes(scenes, config: BuildConfig, map_, progress):
     it = progress(scenes) if progress else scenes
     results = map_(scene_task, [(scene, config, scene_file) for scene, scene_file in scenes])
     for (scene, _), (r, c, rep, caught) in zip(it, results):
-        for category, message in caught:
-            warnings.warn(message, category, stacklevel=3)
+        warn_again(caught, stacklevel=4)
         yield scene, r, c, rep
 
 

@@ -319,18 +319,25 @@ def test_inspect_usd_errors_are_one_line_without_internals(tmp_path, kind, reaso
     assert not any(bad in proc.stderr for bad in _USD_INTERNALS), proc.stderr
 
 
-def test_inspect_summarizes_unresolved_assets_in_one_line(tmp_path):
+def stage_with_unresolved_assets(path, references: int):
+    """A stage of one cube (``Stool``) with an unresolved sublayer and
+    ``references`` lamps referencing files that do not exist (its import
+    warns about each)."""
     from pxr import Gf, Usd, UsdGeom
 
-    path = tmp_path / "busy.usda"
     st = Usd.Stage.CreateNew(str(path))
     UsdGeom.SetStageUpAxis(st, "Z")
     st.SetDefaultPrim(UsdGeom.Xform.Define(st, "/World").GetPrim())
     st.GetRootLayer().subLayerPaths.append("./gone_layer.usda")
     UsdGeom.Cube.Define(st, "/World/Stool").AddTranslateOp().Set(Gf.Vec3d(0.0, 0.0, 1.0))
-    for k in range(6):
+    for k in range(references):
         UsdGeom.Xform.Define(st, f"/World/Lamp_{k}").GetPrim().GetReferences().AddReference(f"./gone_{k}.mtlx")
     st.Save()
+    return path
+
+
+def test_inspect_summarizes_unresolved_assets_in_one_line(tmp_path):
+    path = stage_with_unresolved_assets(tmp_path / "busy.usda", 6)
     proc = run_build("inspect", path, "--json")
     assert proc.returncode == 0, proc.stderr
     assert [i["id"] for i in json.loads(proc.stdout)["instances"]] == ["Stool"]

@@ -13,7 +13,7 @@ import pickle
 
 import pytest
 
-from test_build_cli import assert_one_line_error, listing, run_build
+from test_build_cli import assert_one_line_error, listing, run_build, stage_with_unresolved_assets
 
 
 @pytest.fixture(scope="module")
@@ -58,17 +58,7 @@ def test_episodes_two_workers_write_the_same_bytes(houses):
 def _stage_with_warnings(path):
     """A stage whose import warns (unresolved sublayer and references) and
     whose one room has no navigable cell (a warning of the build)."""
-    from pxr import Gf, Usd, UsdGeom
-
-    st = Usd.Stage.CreateNew(str(path))
-    UsdGeom.SetStageUpAxis(st, "Z")
-    st.SetDefaultPrim(UsdGeom.Xform.Define(st, "/World").GetPrim())
-    st.GetRootLayer().subLayerPaths.append("./gone_layer.usda")
-    UsdGeom.Cube.Define(st, "/World/Stool").AddTranslateOp().Set(Gf.Vec3d(0.0, 0.0, 1.0))
-    for k in range(2):
-        UsdGeom.Xform.Define(st, f"/World/Lamp_{k}").GetPrim().GetReferences().AddReference(f"./gone_{k}.mtlx")
-    st.Save()
-    return path
+    return stage_with_unresolved_assets(path, 2)
 
 
 def test_episodes_workers_warn_like_serial(tmp_path, houses):

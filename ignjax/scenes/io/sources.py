@@ -18,11 +18,10 @@ from __future__ import annotations
 import gzip
 import json
 import os
-import warnings
 from pathlib import Path
 from types import MappingProxyType
 
-from ignjax.errors import SceneError
+from ignjax.errors import SceneError, call_recording_warnings, warn_again
 from ignjax.scenes.io.formats import JSON_SUFFIXES, MESH_SUFFIXES, SIDECAR_SUFFIX, USD_SUFFIXES
 from ignjax.scenes.io.manifest import read_manifest
 from ignjax.scenes.model import Scene, scene_from_dict
@@ -89,6 +88,12 @@ def _json_document(p: Path):
         raise SceneError(p, None, f"cannot read: {e}") from e
 
 
+def _load_recorded(path: Path) -> tuple[list[Scene], list]:
+    """:func:`load_scenes` plus its warnings (:func:`~ignjax.errors.call_recording_warnings`):
+    the unit of work of :func:`scene_sources` in another process."""
+    return call_recording_warnings(load_scenes, path)
+
+
 def _source_files(raw) -> list[Path]:
     """The scene files of one source given to :func:`scene_sources`."""
     p = Path(raw)
@@ -126,22 +131,11 @@ def scene_sources(paths, map_=map) -> list[tuple[object, Path]]:
             out += [(s, f) for s in scenes]
     else:
         for f, (scenes, caught) in zip(files, map_(_load_recorded, files)):
-            for category, message in caught:  # raised here, in file order, as if read here
-                warnings.warn(message, category, stacklevel=2)
+            warn_again(caught)  # raised here, in file order, as if read here
             out += [(s, f) for s in scenes]
     if error is not None:
         raise error
     return out
-
-
-def _load_recorded(path: Path) -> tuple[list[Scene], list]:
-    """:func:`load_scenes` plus the warnings it raised, as ``(category,
-    message)`` pairs (the unit of work of :func:`scene_sources` in another
-    process)."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        scenes = load_scenes(path)
-    return scenes, [(w.category, str(w.message)) for w in caught]
 
 
 # Readers, one per kind of source. Each imports its library when a file of its
