@@ -158,6 +158,10 @@ def test_two_agents_side_by_side(browser, page):
     # the index's episode link opens the first two agents shown side by side
     browser.find_element("css selector", "a[href='#']").click()
     css(browser, f"#index tbody tr[data-row='{i}'] td a", None)[0].click()
+    from selenium.webdriver.support.ui import WebDriverWait
+
+    # the click changes the fragment; the page draws the panels on the hashchange that follows
+    WebDriverWait(browser, 10).until(lambda d: css(d, ".panel"))
     assert [p.get_attribute("data-agent") for p in css(browser, ".panel")] == ["eig", "random"]
     assert console(browser) == []
 
