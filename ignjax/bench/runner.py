@@ -96,9 +96,10 @@ def main(argv=None) -> int:
     if args.scaling:
         from ignjax.bench.scaling import growth_curves, write_growth
 
-        es = load_benchmark(args.episodes or SHIPPED_BENCHMARK)
+        from ignjax.episodes.dataset import open_benchmark
+
         log("how cost grows (EIG rollout) ...")
-        res["scaling"] = growth_curves(es, make_world(es), args.quick)
+        res["scaling"] = growth_curves(open_benchmark(args.episodes or SHIPPED_BENCHMARK), args.quick)
         res["scaling"]["device"] = device
         res["scaling"]["files"] = write_growth(res["scaling"], args.out)
         log(f"  wrote {res['scaling']['files']['png']}")

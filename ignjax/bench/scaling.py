@@ -6,16 +6,19 @@ after its compilation:
 
 * **batch** - decision steps/s and memory against the batch size B
   (:data:`BATCHES`), sharded over every device;
-* **scenes** - the same at B = :data:`SCENES_BATCH` against the number of
-  scenes in the bank (:data:`SCENE_COUNTS`). Where the episode file has
-  fewer scenes than a point asks for, the bank is filled with renamed
-  copies of its scenes (each copy a separate slice of every table, so
-  memory and table sizes grow as with distinct scenes of the same sizes)
-  and the episodes are spread over the copies; the record says how many
-  distinct scenes there were. A point whose world would not fit in
-  :data:`MEMORY_SHARE` of the machine's available memory is skipped with
-  the estimate (the bank pads every scene to the largest one: its memory
-  is the scene count times the largest scene);
+* **scenes** - the same against the number of scenes in the benchmark
+  (:data:`SCENE_COUNTS`): its first n scenes, or, where the episode file
+  has fewer, renamed copies of them (:meth:`BenchmarkScenes.with_scenes`:
+  tables and fields grow as with distinct scenes of the same sizes; the
+  record says how many scenes were distinct). The scenes run as an
+  evaluation runs them (:func:`ignjax.evaluate.runner.plan_run`): in
+  buckets of scenes of similar size of at most ``bank_mb`` MiB each, one
+  bucket's world at a time. Each bucket runs a batch of
+  B = :data:`SCENES_BATCH` of its episodes, compiled first; steps/s is all
+  buckets' steps over their summed time, ``memory_mb`` the largest bucket's
+  program, ``world_mb`` the largest bucket's world and ``bank_total_mb`` the
+  buckets' worlds together (what one process would hold if it kept them
+  all, near the scenes' own sizes: no scene padded to a far larger one);
 * **devices** - steps/s at B = :data:`SCALING_BATCH` sharded over 1, 2 and
   every device (on a CPU, the host devices of :mod:`ignjax.devices`);
 * **vectors** - the in-the-loop sweep (:func:`ignjax.sim.rollout.rollout_sweep`):
@@ -28,6 +31,9 @@ Memory is XLA's analysis of each compiled program on one device
 copy, most of it - outputs and temporaries), so it is the same on every
 backend and does not depend on what ran before; ``rss_mb`` is the process's
 resident high-water mark after the point (points run in increasing size).
+
+The batch, devices and vectors curves run on one bank of the benchmark's
+first :data:`BASE_SCENES` scenes (all of the shipped benchmark's).
 
 ``--quick`` stops each curve early (B up to 4,096, 12 and 50 scenes,
 K up to 256). The figure (``scaling.png``: one panel per curve, steps/s and
@@ -57,52 +63,13 @@ SCENES_BATCH = SCALING_BATCH
 VECTOR_COUNTS = (16, 64, 256, 1024, 4096)
 VECTOR_EPISODES = 100
 """Episodes of each point of the vectors curve (K x 100 rows: 409,600 at K = 4,096)."""
-MEMORY_SHARE = 0.5
-"""A scenes point runs only if its world's estimate stays under this share of the available memory."""
+BASE_SCENES = 12
+"""Scenes of the bank the batch, devices and vectors curves run on (the first of the benchmark's)."""
 QUICK_LIMITS = {"batch": 4096, "scenes": 50, "vectors": 256}
 
 
 def _rss_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
-
-
-def _available_bytes() -> int:
-    try:
-        with open("/proc/meminfo", encoding="utf-8") as fh:
-            for line in fh:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    return int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_AVPHYS_PAGES"))
-
-
-def _tile(es, world, n: int, batch: int):
-    """(world, specs) of a bank of ``n`` scenes made from ``es``'s (renamed
-    copies where it has fewer) and ``batch`` episodes spread over them."""
-    import jax
-    import jax.numpy as jnp
-
-    from ignjax.sim.env import World
-
-    bank, S = world.bank, world.bank.n_scenes
-    idx = np.arange(batch) % len(es)
-    specs = jax.tree.map(lambda a: a[idx], es.specs)
-    if n == S:
-        return world, specs
-    src = np.arange(n) % S
-    take = lambda tree: jax.tree.map(lambda a: a[src], tree)  # noqa: E731
-    ids = tuple(bank.scene_ids[s] if k < S else f"{bank.scene_ids[s]}~{k // S}" for k, s in enumerate(src))
-    bank_n = dataclasses.replace(bank, rays=take(bank.rays), grid=take(bank.grid), instances=take(bank.instances),
-                                 rooms=take(bank.rooms), doors=take(bank.doors), scene_ids=ids,
-                                 compiled=tuple(bank.compiled[s] for s in src),
-                                 navgrids=tuple(bank.navgrids[s] for s in src))
-    world_n = World(bank_n, world.fields, world.config, fine=world.fine[src], packed_obs=world.packed_obs[src])
-    reps = -(-n // S)
-    scene = np.asarray(specs.scene)
-    moved = scene + S * (np.arange(batch) % reps)
-    scene = np.where(moved < n, moved, scene)
-    return world_n, dataclasses.replace(specs, scene=jnp.asarray(scene, specs.scene.dtype))
 
 
 def _world_bytes(world) -> int:
@@ -157,17 +124,57 @@ def bench_devices(es, world, batch: int = SCALING_BATCH) -> dict:
     return {"batch": batch, "devices": {str(c): steps[c] / dt for c, dt in zip(counts, best)}}
 
 
-def growth_curves(es, world, quick: bool, batches=BATCHES, scene_counts=SCENE_COUNTS, vector_counts=VECTOR_COUNTS,
+def scenes_point(bs, n: int, batch: int = SCENES_BATCH, bank_mb: float | None = None) -> dict:
+    """One point of the scenes curve (module docstring): the EIG rollout over
+    ``n`` scenes of ``bs`` (a :class:`~ignjax.episodes.dataset.BenchmarkScenes`),
+    a bucket at a time."""
+    import jax
+
+    from ignjax.agents import get_agent
+    from ignjax.evaluate.runner import BANK_MB, make_world, plan_run
+    from ignjax.sim.rollout import episode_keys
+
+    agent = get_agent("eig")
+    params = agent.default_params()
+    sub = bs.with_scenes(n)
+    plan = plan_run(sub, batch, BANK_MB if bank_mb is None else bank_mb)
+    steps = seconds = 0.0
+    memory: dict = {}
+    worlds = []
+    for pos in plan.buckets:
+        es = sub.episode_set(pos)
+        world = make_world(es)
+        idx = np.arange(batch) % len(es)
+        specs = jax.tree.map(lambda a: a[idx], es.specs)
+        p = _rollout_point(world, specs, agent, params, episode_keys(0, es.key_index[idx]), repeats=1)
+        steps += p["decision_steps"]
+        seconds += p["seconds"]
+        memory = {k: max(v, memory.get(k, 0.0)) for k, v in p["memory_mb"].items()}
+        worlds.append(_world_bytes(world))
+        del es, world
+    return {"steps_per_s": steps / seconds, "seconds": seconds, "decision_steps": steps, "memory_mb": memory,
+            "buckets": len(plan.buckets), "world_mb": max(worlds) / 2**20, "bank_total_mb": sum(worlds) / 2**20,
+            "rss_mb": _rss_mb()}
+
+
+def growth_curves(bs, quick: bool, batches=BATCHES, scene_counts=SCENE_COUNTS, vector_counts=VECTOR_COUNTS,
                   scenes_batch: int = SCENES_BATCH, vector_episodes: int = VECTOR_EPISODES,
-                  devices_batch: int = SCALING_BATCH) -> dict:
-    """The four curves (module docstring) as one record (``devices_batch``
-    0: no devices curve)."""
+                  devices_batch: int = SCALING_BATCH, bank_mb: float | None = None) -> dict:
+    """The four curves (module docstring) of the benchmark ``bs`` (a
+    :class:`~ignjax.episodes.dataset.BenchmarkScenes`) as one record
+    (``devices_batch`` 0: no devices curve; ``bank_mb``: the buckets' budget,
+    default :data:`ignjax.evaluate.runner.BANK_MB`)."""
     import jax
     import jax.numpy as jnp
 
     from ignjax.agents import get_agent
+    from ignjax.evaluate.runner import make_world
     from ignjax.protocol import LOCKED_COSTS
     from ignjax.sim.rollout import episode_keys, rollout_memory, rollout_sweep
+
+    base = bs.with_scenes(min(BASE_SCENES, bs.host.n_scenes))
+    es = base.episode_set(np.arange(len(base)))
+    world = make_world(es)
 
     if quick:
         batches = tuple(b for b in batches if b <= QUICK_LIMITS["batch"])
@@ -175,31 +182,18 @@ def growth_curves(es, world, quick: bool, batches=BATCHES, scene_counts=SCENE_CO
         vector_counts = tuple(k for k in vector_counts if k <= QUICK_LIMITS["vectors"])
     agent = get_agent("eig")
     params = agent.default_params()
-    out: dict = {"agent": "eig", "distinct_scenes": world.bank.n_scenes, "episodes": len(es),
-                 "batch": {}, "scenes": {}, "vectors": {}, "skipped": {}}
+    out: dict = {"agent": "eig", "distinct_scenes": bs.host.n_scenes, "base_scenes": world.bank.n_scenes,
+                 "episodes": len(es), "batch": {}, "scenes": {}, "vectors": {}}
     for B in batches:
         idx = np.arange(B) % len(es)
         specs = jax.tree.map(lambda a: a[idx], es.specs)
         out["batch"][str(B)] = p = _rollout_point(world, specs, agent, params, episode_keys(0, np.arange(B)),
                                                   repeats=1 if B >= 16384 else 2)
         log(f"  B = {B}: {p['steps_per_s']:.3g} steps/s, program {p['memory_mb']['peak']:.0f} MB")
-    per_scene = _world_bytes(world) - int(world.fields.nbytes)
-    per_scene /= world.bank.n_scenes
-    budget = MEMORY_SHARE * _available_bytes()
     for n in scene_counts:
-        need = per_scene * n + world.fields.nbytes
-        if need * max(1, jax.local_device_count()) > budget:
-            out["skipped"][f"scenes={n}"] = (f"the padded bank of {n} scenes needs about {need / 2**30:.1f} GiB per "
-                                             f"device copy, over {MEMORY_SHARE:g} of the {budget / MEMORY_SHARE / 2**30:.1f} "
-                                             "GiB available")
-            log(f"  {n} scenes: skipped ({out['skipped'][f'scenes={n}']})")
-            continue
-        w, specs = _tile(es, world, n, scenes_batch)
-        p = _rollout_point(w, specs, agent, params, episode_keys(0, np.arange(scenes_batch)), repeats=1)
-        p["world_mb"] = _world_bytes(w) / 2**20
-        out["scenes"][str(n)] = p
-        log(f"  {n} scenes: {p['steps_per_s']:.3g} steps/s, world {p['world_mb']:.0f} MB")
-        del w
+        out["scenes"][str(n)] = p = scenes_point(bs, n, scenes_batch, bank_mb)
+        log(f"  {n} scenes: {p['steps_per_s']:.3g} steps/s in {p['buckets']} bucket(s); largest world "
+            f"{p['world_mb']:.0f} MB, all buckets {p['bank_total_mb']:.0f} MB")
     E = vector_episodes
     idx = np.arange(E) % len(es)
     specs = jax.tree.map(lambda a: a[idx], es.specs)
@@ -258,8 +252,7 @@ def plot_growth(rec: dict, path: str | os.PathLike) -> Path:
             ax2.yaxis.set_major_formatter(EngFormatter(sep=""))
             ax2.set_ylabel("peak program memory (MB)", color="tab:red")
         ax.grid(alpha=0.3, which="both")
-    skipped = "; ".join(f"{k}: {v}" for k, v in rec.get("skipped", {}).items())
-    fig.suptitle(f"EIG rollout, {rec.get('device', '')}" + (f"\nskipped {skipped}" if skipped else ""), fontsize=9)
+    fig.suptitle(f"EIG rollout, {rec.get('device', '')}", fontsize=9)
     fig.tight_layout()
     buf = io.BytesIO()
     fig.savefig(buf, dpi=110, format="png")
@@ -279,5 +272,5 @@ def write_growth(rec: dict, out: str | os.PathLike) -> dict:
     return {"json": str(out / "scaling.json"), "png": str(plot_growth(rec, out / "scaling.png"))}
 
 
-__all__ = ["BATCHES", "SCENE_COUNTS", "VECTOR_COUNTS", "SCALING_BATCH", "bench_devices", "growth_curves",
-           "plot_growth", "write_growth"]
+__all__ = ["BASE_SCENES", "BATCHES", "SCENE_COUNTS", "VECTOR_COUNTS", "SCALING_BATCH", "bench_devices",
+           "growth_curves", "plot_growth", "scenes_point", "write_growth"]

@@ -29,12 +29,14 @@ import numpy as np
 
 from ignjax.episodes.difficulty import BIN_INDEX
 from ignjax.episodes.schema import read_episodes
-from ignjax.errors import EpisodeError, IgnjaxError
+from ignjax.errors import ConfigError, EpisodeError, IgnjaxError
 from ignjax.scenes import vocab
 from ignjax.scenes.bank import SceneBank
+from ignjax.scenes.buckets import plan_buckets
+from ignjax.scenes.compile import compile_scene
 from ignjax.scenes.geodesic import goal_fields
 from ignjax.scenes.io.sources import load_scenes
-from ignjax.scenes.navgrid import GridConfig
+from ignjax.scenes.navgrid import GridConfig, build_navgrid
 from ignjax.sim.types import EpisodeSpec
 
 
@@ -49,6 +51,13 @@ class EpisodeSet:
         fields: (F, H, W) float32 geodesic fields of the distinct targets.
         specs: :class:`EpisodeSpec` with a leading axis of len(records).
         field_index: (E,) int32 field of each episode.
+        key_index: (E,) int64 the position of each episode in the run's
+            episode list (the file, cut by ``limit`` / ``indices``), from
+            which its PRNG key comes (:func:`ignjax.sim.rollout.episode_keys`);
+            default ``0 .. E - 1``. A bucket of a streamed run
+            (:class:`BenchmarkScenes`) or a :meth:`subset` keeps each
+            episode's own, so an episode's randomness does not depend on
+            which episodes run beside it.
     """
 
     path: Path
@@ -57,6 +66,11 @@ class EpisodeSet:
     fields: jax.Array
     specs: EpisodeSpec
     field_index: np.ndarray
+    key_index: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.key_index is None:
+            self.key_index = np.arange(len(self.records), dtype=np.int64)
 
     def __len__(self) -> int:
         return len(self.records)
@@ -70,7 +84,7 @@ class EpisodeSet:
         idx = np.asarray(indices, np.int64)
         specs = jax.tree.map(lambda a: a[idx], self.specs)
         return dataclasses.replace(self, records=[self.records[i] for i in idx], specs=specs,
-                                   field_index=self.field_index[idx])
+                                   field_index=self.field_index[idx], key_index=self.key_index[idx])
 
 
 def _resolve_scene_file(name: str, episode_file: Path, scenes_root: Path | None) -> Path:
@@ -148,7 +162,26 @@ def load_benchmark(path: str | os.PathLike, scenes_root: str | os.PathLike | Non
     """Read, validate and prepare an episode file for simulation (see module
     doc). ``limit``: only the first N episodes of the file; ``indices``: only
     these episodes (positions in the file, kept in this order); either way
-    only the scenes they use are loaded."""
+    only the scenes they use are loaded. All in one bank; a benchmark of
+    hundreds of scenes is better run a bucket of scenes at a time
+    (:func:`open_benchmark`)."""
+    bs = open_benchmark(path, scenes_root, grid, limit=limit, indices=indices)
+    return bs.episode_set(np.arange(len(bs.records)), field_batch, progress)
+
+
+def open_benchmark(path: str | os.PathLike, scenes_root: str | os.PathLike | None = None,
+                   grid: GridConfig = GridConfig(), limit: int | None = None, indices=None) -> "BenchmarkScenes":
+    """Read an episode file, load and compile its scenes on the host and check
+    every record against them, building no device table yet (arguments as
+    :func:`load_benchmark`). :meth:`BenchmarkScenes.episode_set` then makes
+    the :class:`EpisodeSet` of any part of it, and
+    :meth:`BenchmarkScenes.buckets` plans a run a bucket of scenes at a time.
+
+    Raises:
+        EpisodeError: as :func:`load_benchmark`, for every record; only the
+            check that a start reaches its target needs the goal fields and
+            is made when a part's :class:`EpisodeSet` is built.
+    """
     p = Path(path)
     records = read_episodes(p)
     if indices is not None:
@@ -179,19 +212,109 @@ def load_benchmark(path: str | os.PathLike, scenes_root: str | os.PathLike | Non
                 raise EpisodeError(p, f"episode {first_use[(f, sid)]}: scene_id",
                                    f"scene {sid!r} not found in {str(f)!r} (it holds {sorted(loaded)})")
             scenes.append(loaded[sid])
-    bank = SceneBank.build(scenes, grid, check=False)
-    specs, pairs, field_index = episode_specs(records, bank, p)
-    fields = compute_fields(bank, pairs, field_batch, progress)
-    # reachability: the start must see a finite geodesic distance to its target
-    fi = np.asarray(field_index)
-    starts = np.asarray(specs.start)
-    for k, rec in enumerate(records):
-        s = int(specs.scene[k])
-        grid_ = bank.navgrids[s]
-        r, c = grid_.world_to_cell(starts[k, :2])
-        if not np.isfinite(np.asarray(fields[fi[k], r, c])):
-            raise EpisodeError(p, f"episode {rec['episode_id']}: start", "the target cannot be reached from the start pose")
-    return EpisodeSet(p, records, bank, fields, specs, field_index)
+    if not scenes:
+        raise EpisodeError(p, "episodes", "no episodes to run (the file, cut by limit / indices, is empty)")
+    compiled = [compile_scene(s) for s in scenes]
+    host = SceneBank.from_compiled(compiled, [build_navgrid(c, grid) for c in compiled], arrays=False)
+    _, _, _ = episode_specs(records, host, p)  # every record checked before any table is built
+    return BenchmarkScenes(p, records, host)
+
+
+@dataclass(eq=False)
+class BenchmarkScenes:
+    """An episode file's records and their scenes, compiled and gridded on the
+    host, with no device table yet (:func:`open_benchmark`).
+
+    Attributes:
+        path: the episode file.
+        records: the run's records (the file, cut by ``limit`` / ``indices``).
+        host: a :class:`~ignjax.scenes.bank.SceneBank` of every scene the
+            records use, host-side lookups only (``arrays=False``).
+    """
+
+    path: Path
+    records: list[dict]
+    host: SceneBank
+
+    def __len__(self) -> int:
+        return len(self.records)
+
+    def scene_of(self) -> np.ndarray:
+        """(E,) int the host bank's index of each record's scene."""
+        return np.array([self.host.scene_index(r["scene_id"]) for r in self.records], np.int64)
+
+    def buckets(self, budget_bytes: float, per_cell: int = 0) -> list[np.ndarray]:
+        """The run's episodes cut into buckets of scenes of similar size whose
+        tables and goal fields fit ``budget_bytes``
+        (:func:`ignjax.scenes.buckets.plan_buckets`; ``per_cell``: the
+        bytes a caller adds per navigation cell, e.g. the simulator's probe
+        maps).
+
+        Returns:
+            Per bucket, the positions of its episodes in :attr:`records`
+            (increasing); one bucket of every episode when all fit.
+        """
+        scene = self.scene_of()
+        targets = {(int(s), r["target_id"]) for s, r in zip(scene, self.records)}
+        fields = np.bincount([s for s, _ in targets], minlength=self.host.n_scenes)
+        plan = plan_buckets(self.host.navgrids, budget_bytes, fields, per_cell)
+        return [np.flatnonzero(np.isin(scene, b)) for b in plan]
+
+    def with_scenes(self, n: int) -> "BenchmarkScenes":
+        """The same benchmark over exactly ``n`` scenes, for measuring how cost
+        grows with the scene count: the first ``n`` scenes (host order) and
+        their records; with fewer scenes than ``n``, renamed copies
+        (``<id>~<k>``) fill the rest, each with a copy of its scene's records
+        (episode ids ``<id>~<k>``), so tables and fields grow as with
+        distinct scenes of the same sizes."""
+        h = self.host
+        if n < 1:
+            raise ConfigError(None, "scenes", f"must be >= 1, got {n}")
+        src = [k % h.n_scenes for k in range(n)]
+        names = [h.scene_ids[s] if k < h.n_scenes else f"{h.scene_ids[s]}~{k // h.n_scenes}" for k, s in enumerate(src)]
+        compiled, grids, records = [], [], []
+        by_scene: dict[str, list[dict]] = {}
+        for r in self.records:
+            by_scene.setdefault(r["scene_id"], []).append(r)
+        for name, s in zip(names, src):
+            c, g = h.compiled[s], h.navgrids[s]
+            if name != h.scene_ids[s]:
+                c = dataclasses.replace(c, scene=dataclasses.replace(c.scene, id=name))
+                g = dataclasses.replace(g, scene_id=name)
+                records += [{**r, "scene_id": name, "episode_id": f"{r['episode_id']}~{name.rsplit('~', 1)[1]}"}
+                            for r in by_scene.get(h.scene_ids[s], [])]
+            else:
+                records += by_scene.get(name, [])
+            compiled.append(c)
+            grids.append(g)
+        return BenchmarkScenes(self.path, records,
+                               SceneBank.from_compiled(compiled, grids, categories=h.categories, arrays=False))
+
+    def episode_set(self, positions, field_batch: int = 32, progress=None) -> EpisodeSet:
+        """The :class:`EpisodeSet` of the records at ``positions`` (in that
+        order): a bank of only the scenes they use (in the host bank's order,
+        with the whole run's category vocabulary), their goal fields, and each
+        episode's :attr:`EpisodeSet.key_index` its position in the run.
+
+        Raises:
+            EpisodeError: a start that cannot reach its target.
+        """
+        idx = np.asarray(positions, np.int64)
+        records = [self.records[i] for i in idx]
+        h = self.host
+        used = sorted({h.scene_index(r["scene_id"]) for r in records})
+        bank = SceneBank.from_compiled([h.compiled[s] for s in used], [h.navgrids[s] for s in used],
+                                       categories=h.categories)
+        p = self.path
+        specs, pairs, field_index = episode_specs(records, bank, p)
+        fields = compute_fields(bank, pairs, field_batch, progress)
+        # reachability: the start must see a finite geodesic distance to its target
+        starts = np.asarray(specs.start)
+        for k, rec in enumerate(records):
+            r, c = bank.navgrids[int(specs.scene[k])].world_to_cell(starts[k, :2])
+            if not np.isfinite(np.asarray(fields[field_index[k], r, c])):
+                raise EpisodeError(p, f"episode {rec['episode_id']}: start", "the target cannot be reached from the start pose")
+        return EpisodeSet(p, records, bank, fields, specs, field_index, key_index=idx)
 
 
 def compute_fields(bank: SceneBank, pairs: list[tuple[int, int]], batch: int = 32, progress=None) -> jax.Array:

@@ -26,7 +26,16 @@ host, :mod:`ignjax.devices.processes`) split the JAX-native agents'
 batches: process i runs the i-th contiguous block of each agent's batches
 of ``--batch`` episodes and writes each finished batch to ``OUT/parts/``;
 process 0 merges them in episode order and writes the outputs once, the
-same bytes as one process. ``--resume`` reuses the parts an interrupted run
+same bytes as one process.
+
+A benchmark of many scenes (the paper's 262 houses) runs a bucket of scenes
+at a time: the scenes are grouped by size into banks of at most
+``--bank-mb`` MiB each (:func:`ignjax.evaluate.runner.plan_run`), and each
+bucket's bank, goal fields and world are built, run and dropped before the
+next, so memory stays at one bucket's whatever the benchmark's size. Each
+bucket is cut into its own batches; an episode's key is its position in the
+file as in a one-bank run, and the outputs are written in episode order.
+The MLLM agents run on one bank (an error names the bucket count otherwise). ``--resume`` reuses the parts an interrupted run
 with the same settings wrote (with any number of processes); ``OUT/parts/``
 is deleted when the outputs are written.
 """
@@ -80,6 +89,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "values in TOML syntax; repeatable")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
     p.add_argument("--limit", type=int, default=0, help="only the first N episodes of the file, for every agent")
+    p.add_argument("--bank-mb", type=float, default=1024,
+                   help="the most one bank of scenes (its tables, probe maps and goal fields; one copy per device) "
+                        "may take, in MiB (default 1024). A benchmark whose scenes do not fit runs in buckets of "
+                        "scenes of similar size, one at a time; the outputs are the same bytes in episode order")
     p.add_argument("--resume", action="store_true",
                    help="reuse the batches an interrupted run with the same settings left in OUT/parts")
     PR.add_arguments(p)
@@ -241,6 +254,8 @@ def check_settings(args, popts: PR.ProcessOptions = PR.ProcessOptions()) -> dict
         raise ConfigError(None, "--costs", f"costs must be non-negative numbers, got {costs}")
     if args.batch < 1:
         raise ConfigError(None, "--batch", f"must be >= 1, got {args.batch}")
+    if not args.bank_mb > 0:
+        raise ConfigError(None, "--bank-mb", f"must be > 0, got {args.bank_mb}")
     if args.parts < 0:
         raise ConfigError(None, "--parts", f"must be >= 0, got {args.parts}")
     if not Path(args.episodes).is_file():
@@ -255,6 +270,7 @@ def _fingerprint(args, sim, used: dict) -> str:
 
     h = hashlib.sha256(Path(args.episodes).read_bytes())
     h.update(json.dumps({"scenes_root": args.scenes_root, "limit": args.limit, "batch": args.batch, "seed": args.seed,
+                         "bank_mb": args.bank_mb,
                          "sim": sim.to_dict(), "agents": used}, sort_keys=True, default=str).encode())
     return h.hexdigest()
 
@@ -266,8 +282,8 @@ def run(args, settings: dict | None = None, popts: PR.ProcessOptions = PR.Proces
 
     from ignjax.agents.params import make_params, param_values_of
     from ignjax.devices.parts import PartStore
-    from ignjax.episodes.dataset import load_benchmark
-    from ignjax.evaluate.runner import agent_batches, batch_count, make_world
+    from ignjax.episodes.dataset import open_benchmark
+    from ignjax.evaluate.runner import bucket_batches, plan_run
 
     st = settings or check_settings(args, popts)
     agents, sim, out_dir, llm, views = st["agents"], st["sim"], st["out_dir"], st["llm"], st["views"]
@@ -294,32 +310,49 @@ def run(args, settings: dict | None = None, popts: PR.ProcessOptions = PR.Proces
             print(f"resuming: {kept} finished batches in {store.root}", file=sys.stderr)
     group.agree(_fingerprint(args, sim, used), "arguments")
     t0 = time.perf_counter()
-    es = load_benchmark(args.episodes, args.scenes_root, limit=args.limit or None)
-    world = make_world(es, sim)
+    bs = open_benchmark(args.episodes, args.scenes_root, limit=args.limit or None)
+    plan = plan_run(bs, args.batch, args.bank_mb)
+    if len(plan.buckets) > 1 and llm_names:
+        raise ConfigError(None, "--bank-mb", f"the {len(bs.host.scene_ids)} scenes need {len(plan.buckets)} buckets "
+                                             f"at --bank-mb {args.bank_mb:g}; the MLLM agents run on one bank: raise "
+                                             "--bank-mb, or evaluate fewer episodes (--limit)")
     if group.main:
-        print(f"loaded {len(es)} episodes in {len(es.bank.scene_ids)} scenes ({time.perf_counter() - t0:.1f} s)",
-              file=sys.stderr)
-    n_batches = batch_count(len(es), args.batch)
+        print(f"loaded {len(bs)} episodes in {len(bs.host.scene_ids)} scenes ({time.perf_counter() - t0:.1f} s)"
+              + (f"; {len(plan.buckets)} buckets of scenes of at most {args.bank_mb:g} MiB, run one at a time"
+                 if len(plan.buckets) > 1 else ""), file=sys.stderr)
+    n_batches = len(plan.chunks)
+    mine = list(group.share(n_batches))
+    jobs, reused, bars = {}, {}, {}
     for agent in agents:
         if agent.name in llm_names:
             continue
+        todo = [i for i in mine if not store.has(f"eval/{agent.name}", i)]
+        jobs[agent.name] = (agent, params[agent.name], todo)
+        reused[agent.name] = len(mine) - len(todo)
+        bars[agent.name] = tqdm(total=len(todo), desc=agent.name, unit="batch", file=sys.stderr, disable=quiet,
+                                dynamic_ncols=True)
+
+    def progress(name, it):
+        for c in it:
+            yield c
+            bars[name].update(1)
+
+    seconds = dict.fromkeys(jobs, 0.0)
+    t1 = time.perf_counter()
+    for name, i, out, traj in bucket_batches(bs, plan, jobs, seed=args.seed, config=sim, parts=args.parts or None,
+                                             progress=progress):
+        store.write(f"eval/{name}", i, {"out": _fields(out), "traj": _fields(traj)})
+        seconds[name] += time.perf_counter() - t1
         t1 = time.perf_counter()
-        bar = (lambda it, name=agent.name: tqdm(it, desc=name, unit="batch", file=sys.stderr, disable=quiet,
-                                                dynamic_ncols=True))
-
-        def compute(select, agent=agent, bar=bar):
-            for i, out, traj in agent_batches(es, agent, params=params[agent.name], batch=args.batch, seed=args.seed,
-                                              progress=bar, world=world, parts=args.parts or None, select=select):
-                yield i, {"out": _fields(out), "traj": _fields(traj)}
-
-        done, reused = store.run_share(f"eval/{agent.name}", n_batches, group, compute)
+    for name, (_, _, todo) in jobs.items():
+        bars[name].close()
         if not quiet:
-            print(f"{agent.name}: {done} batches of {args.batch} episodes in {time.perf_counter() - t1:.1f} s"
-                  + (f" ({reused} from an earlier run)" if reused else "")
+            print(f"{name}: {len(todo)} batches of {args.batch} episodes in {seconds[name]:.1f} s"
+                  + (f" ({reused[name]} from an earlier run)" if reused[name] else "")
                   + (f" (process 0 of {group.count})" if group.count > 1 else ""), file=sys.stderr)
     group.barrier("parts")
     if group.main:
-        _write_outputs(args, st, es, store, n_batches, used, llm_names)
+        _write_outputs(args, st, bs, plan, store, used, llm_names)
         store.remove()
     group.barrier("written")
     return 0
@@ -329,7 +362,7 @@ def _fields(obj) -> dict:
     return {f.name: np.asarray(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
 
 
-def _write_outputs(args, st: dict, es, store, n_batches: int, used: dict, llm_names: set) -> None:
+def _write_outputs(args, st: dict, bs, plan, store, used: dict, llm_names: set) -> None:
     """Process 0: the JAX-native agents' outcomes from the parts, the MLLM agents' from the host loop, every file."""
     from types import SimpleNamespace
 
@@ -342,12 +375,14 @@ def _write_outputs(args, st: dict, es, store, n_batches: int, used: dict, llm_na
     thresholds, costs = st["thresholds"], st["costs"]
     rows = []
     trajectories = {}
+    records = bs.records
+    es = bs.episode_set(plan.buckets[0]) if llm_names else None  # one bucket: checked before the run
     for agent in agents:
         t1 = time.perf_counter()
         if agent.name in llm_names:
             res = run_llm_agent(es, agent, llm, sim=sim, views=views, batch=args.llm_batch, seed=args.seed, costs=costs,
                                 out=out_dir, save_images=args.save_images, progress=not args.quiet)
-            rows += outcome_rows(agent.name, es.records, res.outcomes, res.accounting, llm.prices)
+            rows += outcome_rows(agent.name, records, res.outcomes, res.accounting, llm.prices)
             trajectories[agent.name] = res.trajectories
             write_transcripts(out_dir, agent.name, res.transcripts)
             used[agent.name] = {"options": {k: v for k, v in vars(agent).items()}, "llm": llm.public_dict(),
@@ -356,20 +391,21 @@ def _write_outputs(args, st: dict, es, store, n_batches: int, used: dict, llm_na
                   f"{res.stats['requests']} requests sent ({res.stats['resumed']} episodes from an earlier run)",
                   file=sys.stderr)
             continue
-        tree = store.gather(f"eval/{agent.name}", n_batches)
-        rows += outcome_rows(agent.name, es.records, SimpleNamespace(**tree["out"]))
+        tree = plan.to_run_order(store.gather(f"eval/{agent.name}", len(plan.chunks)))
+        rows += outcome_rows(agent.name, records, SimpleNamespace(**tree["out"]))
         trajectories[agent.name] = tree["traj"]
     used = {a.name: used[a.name] for a in agents}  # in the order of --agent
     p_parquet, p_csv = write_outcomes(rows, out_dir)
     metrics = metric_rows(rows, thresholds, costs, args.require_stop)
     write_metric_table(metrics, out_dir / "metrics.csv")
-    write_trajectories(out_dir, trajectories, es.records, episodes=args.episodes, scenes_root=args.scenes_root,
-                       categories=es.bank.categories, thresholds=thresholds, costs=costs,
+    write_trajectories(out_dir, trajectories, records, episodes=args.episodes, scenes_root=args.scenes_root,
+                       categories=bs.host.categories, thresholds=thresholds, costs=costs,
                        require_stop=args.require_stop, sim=sim.to_dict())
     run_record = {"episodes": str(args.episodes), "seed": args.seed, "batch": args.batch, "thresholds": list(thresholds),
                   "costs": list(costs), "require_stop": args.require_stop,
                   "success_rule": M.success_rule(args.require_stop), "sim": sim.to_dict(), "agents": used,
-                  "limit": args.limit, "model_totals": model_totals(rows, llm.prices if llm else None)}
+                  "limit": args.limit, "bank_mb": args.bank_mb,
+                  "model_totals": model_totals(rows, llm.prices if llm else None)}
     atomic_write(out_dir / "run.json", json.dumps(run_record, indent=2) + "\n")
     print(M.success_rule(args.require_stop))
     if all(t in thresholds for t in SUCCESS_THRESHOLDS):

@@ -284,7 +284,7 @@ class HostLoop:
         self.n = len(es)
         self.B = max(1, min(int(batch), self.n))
         self.render_rows = max(1, llm.concurrency * len(llm.endpoints) // 2)
-        self.keys = episode_keys(seed, np.arange(self.n))
+        self.keys = episode_keys(seed, es.key_index)
         self.names = self._view_names()
         self.categories = es.bank.categories
         self.renderer, self._own_renderer = None, False

@@ -14,11 +14,13 @@ from __future__ import annotations
 import jax
 import numpy as np
 
+from dataclasses import dataclass
+
 from ignjax.agents import Agent, get_agent
-from ignjax.episodes.dataset import EpisodeSet
+from ignjax.episodes.dataset import BenchmarkScenes, EpisodeSet
 from ignjax.sim.rollout import episode_keys, pad_batch, rollout
 from ignjax.sim.env import check_specs
-from ignjax.sim.world import World
+from ignjax.sim.world import FINE, World
 from ignjax.errors import ConfigError
 from ignjax.protocol import N_VIEWS
 from ignjax.sim.types import SimConfig
@@ -39,7 +41,8 @@ def episode_batches(es: EpisodeSet, batch: int, seed: int = 0, progress=None, se
     """Yield ``(n_real, specs, keys)`` for consecutive chunks of ``batch``
     episodes of ``es``: the last chunk padded with masked copies so every
     chunk has the same shape (one compiled rollout), and each episode's key
-    from the seed and its index in the file (:func:`ignjax.sim.rollout.episode_keys`).
+    from the seed and its position in the run (:attr:`EpisodeSet.key_index`,
+    :func:`ignjax.sim.rollout.episode_keys`).
     ``select`` optionally names the chunks to yield (indices in
     ``range(batch_count(len(es), batch))``, in that order): a process's
     share of a run (:mod:`ignjax.devices.processes`); a chunk is the same
@@ -47,7 +50,7 @@ def episode_batches(es: EpisodeSet, batch: int, seed: int = 0, progress=None, se
     of chunk starts (a progress bar)."""
     n = len(es)
     batch = max(1, min(int(batch), n))
-    keys_all = episode_keys(seed, np.arange(n))
+    keys_all = episode_keys(seed, es.key_index)
     starts = list(range(0, n, batch))
     if select is not None:
         starts = [starts[i] for i in select]
@@ -93,4 +96,103 @@ def agent_batches(es: EpisodeSet, agent: Agent | str, *, params=None, batch: int
         yield i, out, traj
 
 
-__all__ = ["agent_batches", "batch_count", "episode_batches", "make_world", "run_agent"]
+WORLD_BYTES_PER_CELL = FINE * FINE + 4
+"""Bytes the simulator's world adds per navigation cell of a scene: its probe
+map (:data:`~ignjax.sim.world.FINE` ^ 2 fine cells of one byte) and the
+packed observation heights (4 bytes)."""
+BANK_MB = 1024
+"""Default budget of one bucket of scenes (``--bank-mb``)."""
+
+
+@dataclass(frozen=True)
+class BucketPlan:
+    """A run of an episode file a bucket of scenes at a time.
+
+    Attributes:
+        buckets: per bucket, the positions of its episodes in the run
+            (increasing; :meth:`BenchmarkScenes.buckets`).
+        batch: episodes per compiled batch; each bucket is cut into its own
+            batches (:func:`episode_batches`), so no batch mixes buckets.
+        chunks: ``(bucket, chunk within the bucket)`` of each of the run's
+            batches, bucket after bucket: the index of a batch in this list
+            is what a process's share and a run's part files count.
+    """
+
+    buckets: tuple[np.ndarray, ...]
+    batch: int
+
+    @property
+    def chunks(self) -> list[tuple[int, int]]:
+        return [(b, c) for b, pos in enumerate(self.buckets) for c in range(batch_count(len(pos), self.batch))]
+
+    @property
+    def order(self) -> np.ndarray:
+        """(E,) the run position of each row of the batches' outputs, concatenated in batch order."""
+        return np.concatenate(self.buckets) if self.buckets else np.zeros(0, np.int64)
+
+    def to_run_order(self, tree):
+        """Outputs concatenated in batch order (arrays with a leading episode axis) -> in run order."""
+        order = self.order
+
+        def put(a):
+            out = np.empty_like(a)
+            out[order] = a
+            return out
+
+        return jax.tree.map(put, tree)
+
+
+def plan_run(bs: BenchmarkScenes, batch: int, bank_mb: float = BANK_MB) -> BucketPlan:
+    """The :class:`BucketPlan` of ``bs`` with buckets of at most ``bank_mb``
+    MiB of scene tables, probe maps and goal fields (one device's copy of the
+    world); one bucket, the whole run, when it fits.
+
+    Raises:
+        ConfigError: ``batch`` or ``bank_mb`` not positive.
+    """
+    if batch < 1:
+        raise ConfigError(None, "batch", f"must be >= 1, got {batch}")
+    if not bank_mb > 0:
+        raise ConfigError(None, "bank_mb", f"must be > 0, got {bank_mb}")
+    return BucketPlan(tuple(bs.buckets(bank_mb * 2**20, WORLD_BYTES_PER_CELL)), int(batch))
+
+
+def bucket_batches(bs: BenchmarkScenes, plan: BucketPlan, jobs: dict, *, seed: int = 0,
+                   config: SimConfig = SimConfig(), parts: int | None = None, progress=None):
+    """Roll out the batches ``jobs`` name, a bucket at a time: each bucket's
+    :class:`EpisodeSet` and world are built once, every job's batches of it
+    run, and both are dropped before the next bucket is built.
+
+    Args:
+        jobs: name -> ``(agent, params, batch indices)`` (indices into
+            :attr:`BucketPlan.chunks`).
+        progress: optional ``progress(name, iterable)`` wrapper of a job's
+            chunks in a bucket.
+
+    Yields:
+        ``(name, batch index, OutcomeRow, Trajectory)``, numpy, the batch's
+        real episodes only; bucket after bucket, the jobs in their order.
+    """
+    chunks = plan.chunks
+    first = [0]
+    for pos in plan.buckets:
+        first.append(first[-1] + batch_count(len(pos), plan.batch))
+    todo = {name: set(int(i) for i in idx) for name, (_, _, idx) in jobs.items()}
+    for b, pos in enumerate(plan.buckets):
+        local = {name: [chunks[i][1] for i in sorted(t) if chunks[i][0] == b] for name, t in todo.items()}
+        if not any(local.values()):
+            continue
+        es = bs.episode_set(pos)
+        world = make_world(es, config)
+        for name, (agent, params, _) in jobs.items():
+            if not local[name]:
+                continue
+            wrap = (lambda it, n=name: progress(n, it)) if progress else None
+            for c, out, traj in agent_batches(es, agent, params=params, batch=plan.batch, seed=seed, world=world,
+                                              parts=parts, select=local[name], progress=wrap):
+                yield name, first[b] + c, out, traj
+        del es, world
+
+
+__all__ = ["BANK_MB", "BucketPlan", "WORLD_BYTES_PER_CELL", "agent_batches", "batch_count", "bucket_batches",
+           "episode_batches", "make_world", "plan_run", "run_agent"]

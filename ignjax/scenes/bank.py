@@ -178,8 +178,20 @@ class SceneBank:
         return cls.from_compiled(compiled, grids)
 
     @classmethod
-    def from_compiled(cls, compiled: Sequence[CompiledScene], grids: Sequence[NavGrid]) -> "SceneBank":
-        """Stack already compiled scenes and their grids (same grid config)."""
+    def from_compiled(cls, compiled: Sequence[CompiledScene], grids: Sequence[NavGrid],
+                      categories: Sequence[str] | None = None, arrays: bool = True) -> "SceneBank":
+        """Stack already compiled scenes and their grids (same grid config).
+
+        Args:
+            categories: the category vocabulary (sorted, holding every
+                category of the scenes); default: the scenes' own. A bucket of
+                a larger benchmark (:mod:`ignjax.episodes.stream`) takes the
+                whole benchmark's, so category indices mean the same in every
+                bucket.
+            arrays: False: the host-side lookups only (ids, vocabulary,
+                compiled scenes, grids), no device tables; for checking
+                episodes and planning before any table is built.
+        """
         compiled = tuple(compiled)
         grids = tuple(grids)
         if not compiled:
@@ -195,7 +207,18 @@ class SceneBank:
             if g.config != config:
                 raise ConfigError(None, "grids", f"scene {g.scene_id!r} was built with another GridConfig")
         scenes = [c.scene for c in compiled]
-        categories = tuple(sorted({i.category for s in scenes for i in s.instances}))
+        own = sorted({i.category for s in scenes for i in s.instances})
+        if categories is None:
+            categories = tuple(own)
+        else:
+            categories = tuple(categories)
+            missing = sorted(set(own) - set(categories))
+            if missing or list(categories) != sorted(set(categories)):
+                raise ConfigError(None, "categories", "must be sorted, unique and hold every category of the scenes"
+                                  + (f"; missing {missing}" if missing else ""))
+        if not arrays:
+            return cls(rays=None, grid=None, instances=None, rooms=None, doors=None, scene_ids=ids,
+                       categories=categories, config=config, compiled=compiled, navgrids=grids)
         return cls(
             rays=ray_grid(grids, compiled),
             grid=_grid_table(grids),

@@ -1,7 +1,7 @@
 """``python -m ignjax.bench --scaling``'s curves (:mod:`ignjax.bench.scaling`)
-at the test benchmark's size: the record, the figure, the bank of copied
-scenes (the same episodes give the same outcomes in it) and the memory
-analysis."""
+at the test benchmark's size: the record, the figure, the scenes copied to
+reach a point's count (a copy's episodes give the same outcomes as the
+original's) and the memory analysis, bucket by bucket."""
 
 from __future__ import annotations
 
@@ -11,8 +11,11 @@ import jax
 import numpy as np
 import pytest
 from ignjax.agents import get_agent
-from ignjax.bench.scaling import _tile, growth_curves, write_growth
-from ignjax.sim.rollout import episode_keys, rollout, rollout_memory
+from ignjax.bench.scaling import growth_curves, write_growth
+from ignjax.episodes.dataset import open_benchmark
+from ignjax.evaluate.runner import WORLD_BYTES_PER_CELL, make_world
+from ignjax.scenes.buckets import padded_bytes
+from ignjax.sim.rollout import episode_keys, rollout
 
 
 def _fields(out):
@@ -20,37 +23,43 @@ def _fields(out):
                                                       "n_questions", "trace_type", "trace_step")}
 
 
-def test_copied_scenes_give_the_same_outcomes(small_benchmark, small_world):
-    es = small_benchmark["set"]
+def test_copied_scenes_give_the_same_outcomes(small_benchmark):
+    """Five scenes made of the test benchmark's two: each copy a scene of its
+    own in the bank, and an episode's copy runs as the episode does."""
+    scenes = open_benchmark(small_benchmark["path"])
+    five = scenes.with_scenes(5)
+    assert five.host.n_scenes == 5 and len(set(five.host.scene_ids)) == 5
+    assert five.host.scene_ids[:2] == scenes.host.scene_ids
+    assert len(five) == sum(len(np.flatnonzero(scenes.scene_of() == k % 2)) for k in range(5))
+    one = scenes.with_scenes(1)
+    assert one.host.n_scenes == 1 and {r["scene_id"] for r in one.records} == {scenes.host.scene_ids[0]}
+    es5 = five.episode_set(np.arange(len(five)))
+    assert es5.bank.n_scenes == 5
+    copies = [k for k, r in enumerate(five.records) if r["scene_id"].endswith("~1")]
+    assert copies
+    originals = [next(k for k, o in enumerate(five.records) if o["episode_id"] == five.records[c]["episode_id"].rsplit("~", 1)[0])
+                 for c in copies]
     agent = get_agent("eig")
     params = agent.default_params()
-    B = 16
-    keys = episode_keys(0, np.arange(B))
-    world5, specs5 = _tile(es, small_world, 5, B)
-    assert world5.bank.n_scenes == 5 and len(set(world5.bank.scene_ids)) == 5
-    scene = np.asarray(specs5.scene)
-    assert scene.max() >= 2, "episodes should be spread over the copies"
-    base_specs = jax.tree.map(lambda a: a[np.arange(B) % len(es)], es.specs)
-    assert np.array_equal(scene % 2, np.asarray(base_specs.scene))
-    a = rollout(small_world, base_specs, agent, params, keys, parts=1)[0]
-    b = rollout(world5, specs5, agent, params, keys, parts=1)[0]
-    fa, fb = _fields(a), _fields(b)
-    assert fa and fa.keys() == fb.keys()
+    world5 = make_world(es5)
+    keys = episode_keys(0, np.zeros(len(copies), np.int64))  # same key for original and copy
+    run = lambda idx: rollout(world5, jax.tree.map(lambda a: a[np.asarray(idx)], es5.specs), agent, params, keys,  # noqa: E731
+                              parts=1)[0]
+    fa, fb = _fields(run(originals)), _fields(run(copies))
     for k in fa:
         assert np.array_equal(fa[k], fb[k]), k
-    m2 = rollout_memory(small_world, base_specs, agent, params, keys, parts=1)
-    m5 = rollout_memory(world5, specs5, agent, params, keys, parts=1)
-    assert m5["arguments"] > m2["arguments"] > 0
-    assert m2["peak"] >= m2["arguments"]
 
 
 @pytest.mark.slow  # about 3 minutes on a 2-core CPU (five rollout programs compiled)
-def test_growth_curves_record_and_figure(small_benchmark, small_world, tmp_path):
-    es = small_benchmark["set"]
-    # a million scenes cannot fit: that point is skipped with its estimate, before anything is allocated
-    rec = growth_curves(es, small_world, quick=False, batches=(16, 32), scene_counts=(2, 4, 10**6), vector_counts=(2,),
-                        scenes_batch=16, vector_episodes=8, devices_batch=16)
-    assert "scenes=1000000" in rec["skipped"] and "GiB" in rec["skipped"]["scenes=1000000"]
+def test_growth_curves_record_and_figure(small_benchmark, tmp_path):
+    scenes = open_benchmark(small_benchmark["path"])
+    # a budget of one scene: the four scenes run in four buckets
+    one = max(padded_bytes([g], 64, WORLD_BYTES_PER_CELL) for g in scenes.host.navgrids) / 2**20
+    rec = growth_curves(scenes, quick=False, batches=(16, 32), scene_counts=(2, 4), vector_counts=(2,),
+                        scenes_batch=16, vector_episodes=8, devices_batch=16, bank_mb=one)
+    assert rec["scenes"]["4"]["buckets"] == 4
+    assert rec["scenes"]["4"]["bank_total_mb"] > rec["scenes"]["2"]["bank_total_mb"]
+    assert rec["scenes"]["4"]["world_mb"] == pytest.approx(rec["scenes"]["2"]["world_mb"])
     for curve, keys in (("batch", ("16", "32")), ("scenes", ("2", "4")), ("vectors", ("2",))):
         assert sorted(rec[curve], key=int) == list(keys), rec[curve]
         for p in rec[curve].values():
@@ -58,8 +67,6 @@ def test_growth_curves_record_and_figure(small_benchmark, small_world, tmp_path)
             assert p["memory_mb"]["peak"] > 0
     # a larger batch needs more temporaries; more scenes a larger world
     assert rec["batch"]["32"]["memory_mb"]["temporaries"] > rec["batch"]["16"]["memory_mb"]["temporaries"]
-    assert rec["scenes"]["4"]["world_mb"] > rec["scenes"]["2"]["world_mb"]
-    assert rec["scenes"]["4"]["memory_mb"]["arguments"] > rec["scenes"]["2"]["memory_mb"]["arguments"]
     assert set(rec["devices"]) >= {"1"} and all(v > 0 for v in rec["devices"].values())
     files = write_growth(rec, tmp_path / "bench")
     png = (tmp_path / "bench" / "scaling.png").read_bytes()

@@ -33,7 +33,8 @@ def _env() -> dict:
 
 
 def _evaluate_args(out: Path) -> list[str]:
-    return [sys.executable, "-m", "ignjax.evaluate", "--episodes", str(EPISODES), "--agent", "random", "--limit", "4",
+    # 24 batches of one episode: process 1 still has batches to run when it is killed after the first part
+    return [sys.executable, "-m", "ignjax.evaluate", "--episodes", str(EPISODES), "--agent", "random", "--limit", "24",
             "--batch", "1", "--quiet", "--out", str(out)]
 
 

@@ -154,10 +154,6 @@ def test_waypoint_is_pulled_back_from_a_wall_straight_ahead(room):
     np.testing.assert_allclose(np.asarray(wp[0]), [x0 + r * math.cos(theta), y0 + r * math.sin(theta)], atol=2e-3)
 
 
-@pytest.mark.xfail(strict=True, reason="the depth ray (ignjax.sim.rays.queries.march) misses every surface when a "
-                                       "component of its direction is exactly 0.0: (m - 1) * t_delta is 0 * inf = NaN "
-                                       "next to geometry, so the traversal stops advancing; the waypoint then lies "
-                                       "3 m out, beyond the wall")
 def test_waypoint_of_an_axis_aligned_pixel_ray_is_pulled_back_from_the_wall(room):
     """The same wall with the pixel's ray turned exactly onto +x (yaw =
     -theta): the waypoint should be 1.95 - 0.3 = 1.65 m straight ahead."""

@@ -25,6 +25,7 @@ from ignjax.scenes.raygrid import RayGrid
 from ignjax.sim.rays.fast import _prim_hit
 
 _OCCUPIED_MAX_CODE = 1  # voxcode 0: partly occupied, 1: inside a primitive, 2: free but touched, >= 3: free
+_NO_STEP = 1e30  # t_delta of an axis the ray does not move along (finite: 0 steps times it is 0)
 
 
 def _occupied(grid: RayGrid, scene, k, row, col):
@@ -102,7 +103,9 @@ def march(grid: RayGrid, scene, pnt, vec, max_dist, *, static_range: float, outs
     cell = jnp.floor(q).astype(jnp.int32)
     nxt = jnp.where(vec >= 0, cell + 1, cell).astype(jnp.float32)
     t_max = jnp.where(jnp.abs(vec) < 1e-9, inf, (nxt - q) * size * inv)
-    t_delta = jnp.where(jnp.abs(vec) < 1e-9, inf, size * jnp.abs(inv))
+    # an axis the ray does not move along: t_max is inf (never crossed) and t_delta finite, so
+    # that the advance's m - 1 = 0 steps along it add 0, not 0 * inf = NaN
+    t_delta = jnp.where(jnp.abs(vec) < 1e-9, _NO_STEP, size * jnp.abs(inv))
     t_floor = jnp.where(include_floor & (vec[2] < 0) & (pnt[2] >= 0), -pnt[2] / safe[2], inf)
     limit = jnp.minimum(max_dist, t_floor)
     zmax = grid.voxcode.shape[1] - 1
