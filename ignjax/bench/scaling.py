@@ -226,7 +226,7 @@ def plot_growth(rec: dict, path: str | os.PathLike) -> Path:
 
     from ignjax.fileio import atomic_write
 
-    panels = (("batch", "batch size B (episodes)"), ("scenes", "scenes in the bank"),
+    panels = (("batch", "batch size B (episodes)"), ("scenes", "scenes (run in buckets, one at a time)"),
               ("devices", "devices"), ("vectors", "cost vectors K (in-the-loop sweep)"))
     fig, axes = plt.subplots(2, 2, figsize=(10, 7.5))
     for ax, (key, label) in zip(axes.ravel(), panels):
