@@ -332,16 +332,11 @@ def run(args, settings: dict | None = None, popts: PR.ProcessOptions = PR.Proces
         bars[agent.name] = tqdm(total=len(todo), desc=agent.name, unit="batch", file=sys.stderr, disable=quiet,
                                 dynamic_ncols=True)
 
-    def progress(name, it):
-        for c in it:
-            yield c
-            bars[name].update(1)
-
     seconds = dict.fromkeys(jobs, 0.0)
     t1 = time.perf_counter()
-    for name, i, out, traj in bucket_batches(bs, plan, jobs, seed=args.seed, config=sim, parts=args.parts or None,
-                                             progress=progress):
+    for name, i, out, traj in bucket_batches(bs, plan, jobs, seed=args.seed, config=sim, parts=args.parts or None):
         store.write(f"eval/{name}", i, {"out": _fields(out), "traj": _fields(traj)})
+        bars[name].update(1)
         seconds[name] += time.perf_counter() - t1
         t1 = time.perf_counter()
     for name, (_, _, todo) in jobs.items():

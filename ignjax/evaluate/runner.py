@@ -90,7 +90,8 @@ def agent_batches(es: EpisodeSet, agent: Agent | str, *, params=None, batch: int
                           f"{world.config.n_views} (other view counts are for image-based agents)")
     check_specs(world, es.specs)
     select = list(range(batch_count(len(es), batch))) if select is None else list(select)
-    for i, (n_real, specs, keys) in zip(select, episode_batches(es, batch, seed, progress, select)):
+    # the chunks first: zip then runs a progress wrapper to its end (its last update) before it stops
+    for (n_real, specs, keys), i in zip(episode_batches(es, batch, seed, progress, select), select):
         out, traj = rollout(world, specs, agent, params, keys, parts=parts)
         out, traj = jax.tree.map(lambda a, m=n_real: np.asarray(a)[:m], (out, traj))
         yield i, out, traj
@@ -158,7 +159,7 @@ def plan_run(bs: BenchmarkScenes, batch: int, bank_mb: float = BANK_MB) -> Bucke
 
 
 def bucket_batches(bs: BenchmarkScenes, plan: BucketPlan, jobs: dict, *, seed: int = 0,
-                   config: SimConfig = SimConfig(), parts: int | None = None, progress=None):
+                   config: SimConfig = SimConfig(), parts: int | None = None):
     """Roll out the batches ``jobs`` name, a bucket at a time: each bucket's
     :class:`EpisodeSet` and world are built once, every job's batches of it
     run, and both are dropped before the next bucket is built.
@@ -166,8 +167,6 @@ def bucket_batches(bs: BenchmarkScenes, plan: BucketPlan, jobs: dict, *, seed: i
     Args:
         jobs: name -> ``(agent, params, batch indices)`` (indices into
             :attr:`BucketPlan.chunks`).
-        progress: optional ``progress(name, iterable)`` wrapper of a job's
-            chunks in a bucket.
 
     Yields:
         ``(name, batch index, OutcomeRow, Trajectory)``, numpy, the batch's
@@ -187,9 +186,8 @@ def bucket_batches(bs: BenchmarkScenes, plan: BucketPlan, jobs: dict, *, seed: i
         for name, (agent, params, _) in jobs.items():
             if not local[name]:
                 continue
-            wrap = (lambda it, n=name: progress(n, it)) if progress else None
             for c, out, traj in agent_batches(es, agent, params=params, batch=plan.batch, seed=seed, world=world,
-                                              parts=parts, select=local[name], progress=wrap):
+                                              parts=parts, select=local[name]):
                 yield name, first[b] + c, out, traj
         del es, world
 
