@@ -22,7 +22,9 @@ process, on the same inputs:
 * **scaling** - decision steps/s of the EIG agent at B = 4096 sharded over
   1, 2 and all devices (``scaling.devices``), measured after compile in
   turns (best of three each), so a machine shared with other work slows
-  them alike.
+  them alike; on a CPU also the one-device program with the process pinned
+  to one core (``scaling.one_device_one_core``: a lone XLA:CPU device runs
+  its larger operations on every core's threads).
 * **limit** - what this machine allows the same rollouts at B = 4096
   (:mod:`ignjax.bench.limit`): its gather rates, read bandwidth and
   elementwise rate, each agent's look-ups and operations per decision step
@@ -144,7 +146,9 @@ def _scaling(es, world=None) -> dict:
 
     log(f"scaling: EIG rollout at B = {SCALING_BATCH} over 1, 2 and all devices ...")
     out = bench_devices(es, world or make_world(es))
-    log("  " + ", ".join(f"{c} devices {v:.0f} decision steps/s" for c, v in out["devices"].items()))
+    log("  " + ", ".join(f"{c} devices {v:.0f} decision steps/s" for c, v in out["devices"].items())
+        + (f"; 1 device with the process pinned to one core {out['one_device_one_core']:.0f}"
+           if "one_device_one_core" in out else ""))
     return out
 
 

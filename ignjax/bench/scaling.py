@@ -99,13 +99,18 @@ def _rollout_point(world, specs, agent, params, keys, parts=None, repeats: int =
                   lambda: rollout_memory(world, specs, agent, params, keys, parts=parts), repeats)
 
 
-def bench_devices(es, world, batch: int = SCALING_BATCH) -> dict:
+def bench_devices(es, world, batch: int = SCALING_BATCH, one_core: bool = True) -> dict:
     """Decision steps/s of the EIG agent's rollout of ``batch`` episodes
     sharded over 1, 2 and all devices (those there are), compiled first and
     then timed in turns (:func:`ignjax.bench.timing.time_interleaved`).
 
+    On a CPU with several devices (and ``one_core``) it also times the
+    one-device program in a process pinned to one core
+    (``one_device_one_core``, :func:`one_core_steps`; ``es`` must be the
+    whole of its episode file).
+
     Returns:
-        {"batch": batch, "devices": {str(count): steps/s}}.
+        {"batch": batch, "devices": {str(count): steps/s}[, "one_device_one_core": steps/s]}.
     """
     import jax
 
@@ -121,7 +126,46 @@ def bench_devices(es, world, batch: int = SCALING_BATCH) -> dict:
     runs = [lambda c=c: jax.block_until_ready(rollout(world, specs, agent, params, keys, parts=c)) for c in counts]
     steps = {c: float(np.asarray(run()[0].steps).sum()) for c, run in zip(counts, runs)}  # compile
     best = time_interleaved(runs, SCALING_REPEATS)
-    return {"batch": batch, "devices": {str(c): steps[c] / dt for c, dt in zip(counts, best)}}
+    out = {"batch": batch, "devices": {str(c): steps[c] / dt for c, dt in zip(counts, best)}}
+    if one_core and jax.default_backend() == "cpu" and len(counts) > 1 and hasattr(os, "sched_setaffinity"):
+        out["one_device_one_core"] = one_core_steps(es.path, batch)
+    return out
+
+
+def one_core_steps(episodes, batch: int = SCALING_BATCH) -> float:
+    """EIG decision steps/s of :func:`bench_devices`' one-device program in a
+    process of one CPU device pinned to one core (Linux): XLA:CPU runs a lone
+    device's larger operations on every core's threads, so the one-device
+    figure of a process with several devices is not one core's.
+
+    Raises:
+        RuntimeError: the process failed (its stderr's end).
+    """
+    import subprocess
+    import sys
+
+    core = min(os.sched_getaffinity(0))
+    # the child pins itself before JAX starts, so every thread it makes inherits the one core
+    code = ("import json, os, sys; os.sched_setaffinity(0, {int(sys.argv[3])}); "
+            "from ignjax.bench.scaling import _one_core_child; "
+            "print(json.dumps(_one_core_child(sys.argv[1], int(sys.argv[2]))))")
+    r = subprocess.run([sys.executable, "-c", code, str(episodes), str(int(batch)), str(core)], capture_output=True,
+                       text=True, env=dict(os.environ, IGNJAX_CPU_DEVICES="1"), timeout=1800)
+    if r.returncode != 0:
+        raise RuntimeError(f"the one-core process failed: {r.stderr[-2000:]}")
+    return float(json.loads(r.stdout.strip().splitlines()[-1]))
+
+
+def _one_core_child(episodes: str, batch: int) -> float:
+    """:func:`one_core_steps`' process: one CPU device, the same episodes and batch."""
+    from ignjax.devices import configure_cpu_devices
+
+    configure_cpu_devices()
+    from ignjax.episodes.dataset import load_benchmark
+    from ignjax.evaluate.runner import make_world
+
+    es = load_benchmark(episodes)
+    return bench_devices(es, make_world(es), batch)["devices"]["1"]
 
 
 def scenes_point(bs, n: int, batch: int = SCENES_BATCH, bank_mb: float | None = None) -> dict:
@@ -209,7 +253,11 @@ def growth_curves(bs, quick: bool, batches=BATCHES, scene_counts=SCENE_COUNTS, v
         out["vectors"][str(K)] = p
         log(f"  {K} cost vectors x {E} episodes: {p['steps_per_s']:.3g} steps/s, {p['seconds']:.1f} s")
     if devices_batch:
-        out["devices"] = bench_devices(es, world, devices_batch)["devices"]
+        dev = bench_devices(es, world, devices_batch, one_core=base.host.n_scenes == bs.host.n_scenes
+                            and len(base) == len(bs))
+        out["devices"] = dev["devices"]
+        if "one_device_one_core" in dev:
+            out["one_device_one_core"] = dev["one_device_one_core"]
         out["devices_batch"] = devices_batch
     return out
 

@@ -6,6 +6,7 @@ original's) and the memory analysis, bucket by bucket."""
 from __future__ import annotations
 
 import json
+import os
 
 import jax
 import numpy as np
@@ -68,6 +69,8 @@ def test_growth_curves_record_and_figure(small_benchmark, tmp_path):
     # a larger batch needs more temporaries; more scenes a larger world
     assert rec["batch"]["32"]["memory_mb"]["temporaries"] > rec["batch"]["16"]["memory_mb"]["temporaries"]
     assert set(rec["devices"]) >= {"1"} and all(v > 0 for v in rec["devices"].values())
+    if len(rec["devices"]) > 1 and hasattr(os, "sched_setaffinity"):  # one device in a process pinned to one core
+        assert rec["one_device_one_core"] > 0
     files = write_growth(rec, tmp_path / "bench")
     png = (tmp_path / "bench" / "scaling.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
