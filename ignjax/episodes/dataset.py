@@ -216,7 +216,7 @@ def open_benchmark(path: str | os.PathLike, scenes_root: str | os.PathLike | Non
         raise EpisodeError(p, "episodes", "no episodes to run (the file, cut by limit / indices, is empty)")
     compiled = [compile_scene(s) for s in scenes]
     host = SceneBank.from_compiled(compiled, [build_navgrid(c, grid) for c in compiled], arrays=False)
-    _, _, _ = episode_specs(records, host, p)  # every record checked before any table is built
+    episode_specs(records, host, p)  # every record checked before any table is built
     return BenchmarkScenes(p, records, host)
 
 
@@ -308,12 +308,12 @@ class BenchmarkScenes:
         p = self.path
         specs, pairs, field_index = episode_specs(records, bank, p)
         fields = compute_fields(bank, pairs, field_batch, progress)
-        # reachability: the start must see a finite geodesic distance to its target
-        starts = np.asarray(specs.start)
-        for k, rec in enumerate(records):
-            r, c = bank.navgrids[int(specs.scene[k])].world_to_cell(starts[k, :2])
-            if not np.isfinite(np.asarray(fields[field_index[k], r, c])):
-                raise EpisodeError(p, f"episode {rec['episode_id']}: start", "the target cannot be reached from the start pose")
+        # reachability: the start must see a finite geodesic distance to its target (one gather for all)
+        starts, scene = np.asarray(specs.start), np.asarray(specs.scene)
+        cells = np.array([bank.navgrids[s].world_to_cell(xy) for s, xy in zip(scene, starts[:, :2])], np.int64)
+        at_start = np.asarray(fields[field_index, cells[:, 0], cells[:, 1]]) if len(records) else np.zeros(0)
+        for k in np.flatnonzero(~np.isfinite(at_start))[:1]:
+            raise EpisodeError(p, f"episode {records[k]['episode_id']}: start", "the target cannot be reached from the start pose")
         return EpisodeSet(p, records, bank, fields, specs, field_index, key_index=idx)
 
 
