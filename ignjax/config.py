@@ -157,6 +157,9 @@ class EvalConfig:
             (``ignjax.agents.llm.catalog.LLM_AGENTS``, e.g. ``vlm``; they need the ``[llm]`` table's server).
         batch: episodes per compiled rollout.
         parts: devices each batch is sharded over (``ignjax.sim.rollout``); 0: all of them.
+        bank_mb: the most one bank of scenes (its tables, probe maps and goal fields; one copy per device) may
+            take, MiB; a benchmark whose scenes do not fit runs in buckets of scenes of similar size, one at a
+            time, with the same results (``ignjax.evaluate.runner.plan_run``).
         thresholds: success distances tau of the SR / OSR / WSR columns, m; positive and increasing.
         costs: per-type question costs charged by WSR (Type 1 appearance, 2 region, 3 route, 4 confirmation);
             default the paper's locked costs.
@@ -168,6 +171,7 @@ class EvalConfig:
     agents: tuple[str, ...] = ("random", "explorer", "naive_asker", "eig", "shortest_path")
     batch: int = 256
     parts: int = 0
+    bank_mb: float = 1024.0
     thresholds: tuple[float, ...] = SUCCESS_THRESHOLDS
     costs: tuple[float, ...] = LOCKED_COSTS
     require_stop: bool = SUCCESS_REQUIRES_STOP
@@ -185,6 +189,8 @@ class EvalConfig:
             raise ConfigError(None, "eval.batch", "must be >= 1")
         if self.parts < 0:
             raise ConfigError(None, "eval.parts", f"must be >= 0 (0: all devices), got {self.parts}")
+        if not self.bank_mb > 0:
+            raise ConfigError(None, "eval.bank_mb", f"must be > 0, got {self.bank_mb}")
         if tuple(sorted(self.thresholds)) != self.thresholds or any(t <= 0 for t in self.thresholds):
             raise ConfigError(None, "eval.thresholds", "must be positive and increasing")
 

@@ -127,25 +127,6 @@ class PartStore:
 
         return {k: cat(k, [p[k] for p in parts]) for k in parts[0]}
 
-    def run_share(self, stage: str, n: int, group, compute) -> tuple[int, int]:
-        """Write the parts of ``stage`` that are this process's share of its
-        ``n`` batches (``group.share(n)``, a
-        :class:`~ignjax.devices.processes.ProcessGroup`) and not yet written.
-
-        Args:
-            compute: ``compute(indices)`` yields ``(index, tree)`` for the
-                batches named, in that order.
-
-        Returns:
-            (parts computed, parts found already written).
-        """
-        mine = list(group.share(n))
-        todo = [i for i in mine if not self.has(stage, i)]
-        if todo:
-            for i, tree in compute(todo):
-                self.write(stage, i, tree)
-        return len(todo), len(mine) - len(todo)
-
     def remove(self, stage: str | None = None) -> None:
         """Delete one stage's parts (or, with None, the whole folder)."""
         shutil.rmtree(self.root if stage is None else self.root / _stage_dir(stage), ignore_errors=True)

@@ -260,6 +260,14 @@ class BenchmarkScenes:
         plan = plan_buckets(self.host.navgrids, budget_bytes, fields, per_cell)
         return [np.flatnonzero(np.isin(scene, b)) for b in plan]
 
+    def host_set(self) -> EpisodeSet:
+        """The whole run as an :class:`EpisodeSet` without device tables: the
+        host-side bank (:attr:`host`), the records and their specs, no goal
+        fields (``fields`` is None). For what reads episodes and scenes but
+        simulates nothing (reports, studies of finished rollouts)."""
+        specs, _, field_index = episode_specs(self.records, self.host, self.path)
+        return EpisodeSet(self.path, self.records, self.host, None, specs, field_index)
+
     def with_scenes(self, n: int) -> "BenchmarkScenes":
         """The same benchmark over exactly ``n`` scenes, for measuring how cost
         grows with the scene count: the first ``n`` scenes (host order) and

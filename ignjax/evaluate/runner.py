@@ -131,13 +131,18 @@ class BucketPlan:
         """(E,) the run position of each row of the batches' outputs, concatenated in batch order."""
         return np.concatenate(self.buckets) if self.buckets else np.zeros(0, np.int64)
 
-    def to_run_order(self, tree):
-        """Outputs concatenated in batch order (arrays with a leading episode axis) -> in run order."""
+    def to_run_order(self, tree, axis: int = 0):
+        """Outputs concatenated in batch order along ``axis`` (the episode axis) -> in run order."""
         order = self.order
+        if np.array_equal(order, np.arange(len(order))):
+            return tree
 
         def put(a):
+            a = np.asarray(a)
             out = np.empty_like(a)
-            out[order] = a
+            index = [slice(None)] * a.ndim
+            index[axis] = order
+            out[tuple(index)] = a
             return out
 
         return jax.tree.map(put, tree)
@@ -158,11 +163,38 @@ def plan_run(bs: BenchmarkScenes, batch: int, bank_mb: float = BANK_MB) -> Bucke
     return BucketPlan(tuple(bs.buckets(bank_mb * 2**20, WORLD_BYTES_PER_CELL)), int(batch))
 
 
+def bucket_worlds(bs: BenchmarkScenes, plans: dict, todo: dict, config: SimConfig = SimConfig()):
+    """The buckets that have work, one at a time: each bucket's
+    :class:`EpisodeSet` and world are built once, handed out, and dropped
+    before the next bucket is built.
+
+    Args:
+        plans: key -> :class:`BucketPlan` (the same buckets; the batch may differ, e.g. a sweep's in-loop stage).
+        todo: key -> the batch indices (into that plan's :attr:`BucketPlan.chunks`) to run.
+
+    Yields:
+        ``(EpisodeSet, World, {key: [(batch index, chunk within the bucket), ...]})`` for each bucket
+        with work, in bucket order, each key's batches in increasing order.
+    """
+    keys = list(plans)
+    if not keys:
+        return
+    buckets = plans[keys[0]].buckets
+    chunks = {k: plans[k].chunks for k in keys}
+    where = {k: {int(i): chunks[k][int(i)] for i in todo.get(k, ())} for k in keys}
+    for b, pos in enumerate(buckets):
+        work = {k: [(i, c) for i, (bb, c) in sorted(where[k].items()) if bb == b] for k in keys}
+        if not any(work.values()):
+            continue
+        es = bs.episode_set(pos)
+        world = make_world(es, config)
+        yield es, world, work
+        del es, world
+
+
 def bucket_batches(bs: BenchmarkScenes, plan: BucketPlan, jobs: dict, *, seed: int = 0,
                    config: SimConfig = SimConfig(), parts: int | None = None):
-    """Roll out the batches ``jobs`` name, a bucket at a time: each bucket's
-    :class:`EpisodeSet` and world are built once, every job's batches of it
-    run, and both are dropped before the next bucket is built.
+    """Roll out the batches ``jobs`` name, a bucket at a time (:func:`bucket_worlds`).
 
     Args:
         jobs: name -> ``(agent, params, batch indices)`` (indices into
@@ -172,25 +204,16 @@ def bucket_batches(bs: BenchmarkScenes, plan: BucketPlan, jobs: dict, *, seed: i
         ``(name, batch index, OutcomeRow, Trajectory)``, numpy, the batch's
         real episodes only; bucket after bucket, the jobs in their order.
     """
-    chunks = plan.chunks
-    first = [0]
-    for pos in plan.buckets:
-        first.append(first[-1] + batch_count(len(pos), plan.batch))
-    todo = {name: set(int(i) for i in idx) for name, (_, _, idx) in jobs.items()}
-    for b, pos in enumerate(plan.buckets):
-        local = {name: [chunks[i][1] for i in sorted(t) if chunks[i][0] == b] for name, t in todo.items()}
-        if not any(local.values()):
-            continue
-        es = bs.episode_set(pos)
-        world = make_world(es, config)
+    todo = {name: idx for name, (_, _, idx) in jobs.items()}
+    for es, world, work in bucket_worlds(bs, dict.fromkeys(jobs, plan), todo, config):
         for name, (agent, params, _) in jobs.items():
-            if not local[name]:
+            if not work[name]:
                 continue
+            index = {c: i for i, c in work[name]}
             for c, out, traj in agent_batches(es, agent, params=params, batch=plan.batch, seed=seed, world=world,
-                                              parts=parts, select=local[name]):
-                yield name, first[b] + c, out, traj
-        del es, world
+                                              parts=parts, select=[c for _, c in work[name]]):
+                yield name, index[c], out, traj
 
 
 __all__ = ["BANK_MB", "BucketPlan", "WORLD_BYTES_PER_CELL", "agent_batches", "batch_count", "bucket_batches",
-           "episode_batches", "make_world", "plan_run", "run_agent"]
+           "bucket_worlds", "episode_batches", "make_world", "plan_run", "run_agent"]

@@ -33,10 +33,10 @@ from ignjax.config import SweepConfig, digest, fingerprint
 from ignjax.devices.parts import PartStore
 from ignjax.devices.processes import SINGLE, ProcessGroup
 from ignjax.episodes.construct import BuildConfig, build_benchmark
-from ignjax.episodes.dataset import load_benchmark
+from ignjax.episodes.dataset import BenchmarkScenes, open_benchmark
 from ignjax.episodes.schema import construction_path, read_episodes, write_records
 from ignjax.errors import ConfigError, InputError
-from ignjax.evaluate.runner import agent_batches, batch_count, episode_batches, make_world
+from ignjax.evaluate.runner import BucketPlan, agent_batches, bucket_worlds, episode_batches, plan_run
 from ignjax.scenes.io.sources import scene_sources
 from ignjax.sim.rollout import batch_parts, rollout_sweep
 from ignjax.sweep.checkpoints import Checkpoints, prepare_folder
@@ -83,16 +83,19 @@ def benchmark_path(cfg: SweepConfig, out_root: Path, progress=None) -> Path:
     return path
 
 
-def load_episodes(cfg: SweepConfig, path: Path):
-    """The episode set at ``path``, cut to ``benchmark.limit`` episodes spread evenly over the file."""
+def load_episodes(cfg: SweepConfig, path: Path) -> BenchmarkScenes:
+    """The episodes at ``path``, cut to ``benchmark.limit`` episodes spread
+    evenly over the file, with their scenes compiled on the host
+    (:func:`~ignjax.episodes.dataset.open_benchmark`; the stages build one
+    bucket of scenes' tables at a time)."""
     n = len(read_episodes(path))
     if n == 0:
         raise InputError(str(path), "episodes", "the episode file holds no episodes")
     limit = cfg.benchmark.limit
     if 0 < limit < n:
         # only the scenes the chosen episodes use are loaded
-        return load_benchmark(path, indices=np.unique(np.linspace(0, n - 1, limit).round().astype(np.int64)))
-    return load_benchmark(path)
+        return open_benchmark(path, indices=np.unique(np.linspace(0, n - 1, limit).round().astype(np.int64)))
+    return open_benchmark(path)
 
 
 # ---------------------------------------------------------------------------
@@ -100,44 +103,16 @@ def load_episodes(cfg: SweepConfig, path: Path):
 # ---------------------------------------------------------------------------
 
 
-def _batch_sizes(n: int, batch: int, select) -> int:
-    """Episodes in the chunks ``select`` of ``n`` episodes cut into ``batch``."""
-    batch = max(1, min(int(batch), n))
-    return sum(min(batch, n - i * batch) for i in select)
-
-
-def eval_stage_parts(es, world, agent_name: str, cfg: SweepConfig, store: PartStore, group: ProcessGroup = SINGLE,
-                     bar=None) -> int:
-    """This process's share of one agent's rollouts, as part files (:mod:`ignjax.devices.parts`).
-
-    Returns:
-        Episodes rolled out here (for a progress display).
-    """
-    name = f"eval/{agent_name}"
-    # a cost-aware agent plans with the costs it is charged (eval.costs)
-    params = cfg.agents.make(agent_name, costs=cfg.eval.costs)
-    n = len(es)
-
-    def compute(select):
-        def prog(chunks):
-            for c in chunks:
-                yield c
-                if bar is not None:
-                    bar.update(min(cfg.eval.batch, n - c))
-
-        for i, out, traj in agent_batches(es, agent_name, params=params, batch=cfg.eval.batch, seed=cfg.run.seed,
-                                          world=world, progress=prog, parts=cfg.eval.parts or None, select=select):
-            yield i, {"out": _to_tree(out), "traj": _to_tree(traj)}
-
-    store.run_share(name, batch_count(n, cfg.eval.batch), group, compute)
-    return _batch_sizes(n, cfg.eval.batch, group.share(batch_count(n, cfg.eval.batch)))
-
-
-def merge_stage(name: str, n_batches: int, ckpt: Checkpoints, store: PartStore, axes=None, extra=None) -> dict:
-    """A stage's result from its parts (process 0), checkpointed; the parts are then deleted."""
+def merge_stage(name: str, n_batches: int, ckpt: Checkpoints, store: PartStore, axes=None, extra=None,
+                order=None) -> dict:
+    """A stage's result from its parts (process 0), checkpointed; the parts are then deleted.
+    ``order``: optionally a function putting a gathered top-level entry (its key, its tree) into episode order."""
     if ckpt.has(name):
         return ckpt.load(name)
-    tree = {**store.gather(name, n_batches, axes), **(extra or {})}
+    tree = store.gather(name, n_batches, axes)
+    if order is not None:
+        tree = {k: order(k, v) for k, v in tree.items()}
+    tree = {**tree, **(extra or {})}
     ckpt.save(name, tree)
     store.remove(name)
     return tree
@@ -161,7 +136,7 @@ def run_llm_stage(es, agent_name: str, cfg: SweepConfig, out: Path, bar=None, qu
             "questions": question_texts(res.transcripts)}
 
 
-def _costs_setup(es, cfg: SweepConfig):
+def _costs_setup(cfg: SweepConfig):
     costs, _ = in_loop_costs(cfg)
     agent = get_agent(cfg.costs.agent)
     if not plans_with_costs(agent):
@@ -171,26 +146,52 @@ def _costs_setup(es, cfg: SweepConfig):
     return costs, agent, batch
 
 
-def costs_stage_parts(es, world, cfg: SweepConfig, store: PartStore, group: ProcessGroup = SINGLE, bar=None) -> int:
-    """This process's share of the cost-aware agent under K charged cost vectors x all episodes (vmapped over K):
-    every cost vector of its chunks of episodes, so that each chunk is the same program as in one process."""
-    costs, agent, batch = _costs_setup(es, cfg)
+def _costs_params(cfg: SweepConfig, agent, costs):
+    """The cost-aware agent's parameters, one row per charged cost vector (each setting plans with the vector it
+    is charged)."""
     base = cfg.agents.make(agent.name)
-    K = len(costs)
-    params = jax.tree.map(lambda x: jnp.broadcast_to(x, (K,) + jnp.shape(x)), base)
-    # each setting plans with the cost vector it is charged
-    params = dataclasses.replace(params, costs=jnp.asarray(costs, jnp.float32))
+    params = jax.tree.map(lambda x: jnp.broadcast_to(x, (len(costs),) + jnp.shape(x)), base)
+    return dataclasses.replace(params, costs=jnp.asarray(costs, jnp.float32))
 
-    def compute(select):
-        for i, (n_real, specs, keys) in zip(select, episode_batches(es, batch, cfg.run.seed, select=select)):
-            out, _ = rollout_sweep(world, specs, agent, params, keys, parts=cfg.eval.parts or None)
-            yield i, {"out": {k: v[:, :n_real] for k, v in _to_tree(out).items()}}
-            if bar is not None:
-                bar.update(n_real * K)
 
-    n = batch_count(len(es), batch)
-    store.run_share("costs/in_loop", n, group, compute)
-    return _batch_sizes(len(es), batch, group.share(n)) * K
+def rollout_stage_parts(bs: BenchmarkScenes, plans: dict, todo: dict, cfg: SweepConfig, store: PartStore):
+    """This process's batches of the rollout stages, a bucket of scenes at a time
+    (:func:`ignjax.evaluate.runner.bucket_worlds`), each written as a part file.
+
+    Args:
+        plans: stage -> :class:`~ignjax.evaluate.runner.BucketPlan`: ``eval/<agent>`` (``eval.batch``
+            episodes a batch) and ``costs/in_loop`` (the cost-aware agent under all K cost vectors, vmapped,
+            on smaller batches so each batch is the same program as in one process).
+        todo: stage -> the batch indices to run.
+
+    Yields:
+        rows rolled out per finished batch (episodes x settings), for a progress display.
+    """
+    parts = cfg.eval.parts or None
+    seed = cfg.run.seed
+    if "costs/in_loop" in plans:
+        costs, c_agent, _ = _costs_setup(cfg)
+        c_params = _costs_params(cfg, c_agent, costs)
+    for es, world, work in bucket_worlds(bs, plans, todo, cfg.sim):
+        for stage, batches in work.items():
+            if not batches:
+                continue
+            index = {c: i for i, c in batches}
+            select = [c for _, c in batches]
+            if stage == "costs/in_loop":
+                for (n_real, specs, keys), c in zip(episode_batches(es, plans[stage].batch, seed, select=select),
+                                                    select):
+                    out, _ = rollout_sweep(world, specs, c_agent, c_params, keys, parts=parts)
+                    store.write(stage, index[c], {"out": {k: v[:, :n_real] for k, v in _to_tree(out).items()}})
+                    yield n_real * len(costs)
+                continue
+            agent = stage.split("/", 1)[1]
+            # a cost-aware agent plans with the costs it is charged (eval.costs)
+            params = cfg.agents.make(agent, costs=cfg.eval.costs)
+            for c, out, traj in agent_batches(es, agent, params=params, batch=plans[stage].batch, seed=seed,
+                                              world=world, parts=parts, select=select):
+                store.write(stage, index[c], {"out": _to_tree(out), "traj": _to_tree(traj)})
+                yield len(out.steps)
 
 
 # ---------------------------------------------------------------------------
@@ -244,41 +245,51 @@ def run_sweep(cfg: SweepConfig, studies: list[str], out: Path, *, resume: bool =
     results: dict = {"config": cfg, "studies": studies}
     if needs_rollouts:
         path = benchmark_path(cfg, Path(cfg.run.out))
-        es = load_episodes(cfg, path)
+        bs = load_episodes(cfg, path)
+        plan = plan_run(bs, cfg.eval.batch, cfg.eval.bank_mb)
+        llm_agents = [a for a in agents if a in LLM_AGENTS]
+        if llm_agents and len(plan.buckets) > 1:
+            raise ConfigError(None, "eval.bank_mb",
+                              f"the {bs.host.n_scenes} scenes need {len(plan.buckets)} buckets at eval.bank_mb = "
+                              f"{cfg.eval.bank_mb:g}; the MLLM agents ({', '.join(llm_agents)}) run on one bank: "
+                              "raise eval.bank_mb, or run fewer episodes (benchmark.limit)")
         if group.main:
-            print(f"benchmark {path} ({len(es)} episodes) ready in {time.perf_counter() - t0:.1f} s", file=sys.stderr)
-        world = make_world(es, cfg.sim)
+            print(f"benchmark {path} ({len(bs)} episodes in {bs.host.n_scenes} scenes"
+                  + (f", {len(plan.buckets)} buckets run one at a time" if len(plan.buckets) > 1 else "")
+                  + f") ready in {time.perf_counter() - t0:.1f} s", file=sys.stderr)
         ckpt = Checkpoints(out / "checkpoints")
-        jax_agents = [a for a in agents if a not in LLM_AGENTS]
-        share = group.share
+        plans = {f"eval/{a}": plan for a in agents if a not in LLM_AGENTS}
         k_costs = len(in_loop_costs(cfg)[0]) if "costs" in studies else 0
-        costs_batch = max(1, cfg.eval.batch // max(1, k_costs // 4))
-        total = (sum(0 if ckpt.has(f"eval/{a}") else _batch_sizes(len(es), cfg.eval.batch,
-                                                                  share(batch_count(len(es), cfg.eval.batch)))
-                     for a in jax_agents)
-                 + (_batch_sizes(len(es), costs_batch, share(batch_count(len(es), costs_batch))) * k_costs
-                    if k_costs and not ckpt.has("costs/in_loop") else 0))
-        with tqdm(total=total, desc="rollouts", unit="ep", file=sys.stderr, disable=quiet or not group.main,
+        if k_costs:
+            plans["costs/in_loop"] = BucketPlan(plan.buckets, _costs_setup(cfg)[2])
+        todo = {}
+        rows = 0
+        for stage, p in plans.items():
+            if ckpt.has(stage):
+                continue
+            todo[stage] = [i for i in group.share(len(p.chunks)) if not store.has(stage, i)]
+            chunks = p.chunks
+            rows += sum(min(p.batch, len(p.buckets[chunks[i][0]]) - chunks[i][1] * p.batch) for i in todo[stage]) * (
+                k_costs if stage == "costs/in_loop" else 1)
+        with tqdm(total=rows, desc="rollouts", unit="ep", file=sys.stderr, disable=quiet or not group.main,
                   dynamic_ncols=True) as bar:
-            for a in jax_agents:
-                if not ckpt.has(f"eval/{a}"):
-                    bar.set_postfix_str(a)
-                    eval_stage_parts(es, world, a, cfg, store, group, bar)
-            if k_costs and not ckpt.has("costs/in_loop"):
-                bar.set_postfix_str(f"{cfg.costs.agent} x {k_costs} cost vectors")
-                costs_stage_parts(es, world, cfg, store, group, bar)
+            for n_rows in rollout_stage_parts(bs, {k: plans[k] for k in todo}, todo, cfg, store):
+                bar.update(n_rows)
         group.barrier("parts")
         if group.main:
             rollouts = {}
             for a in agents:
-                rollouts[a] = (run_llm_stage(es, a, cfg, out, None, quiet) if a in LLM_AGENTS
-                               else merge_stage(f"eval/{a}", batch_count(len(es), cfg.eval.batch), ckpt, store))
+                rollouts[a] = (run_llm_stage(bs.episode_set(plan.buckets[0]), a, cfg, out, None, quiet)
+                               if a in LLM_AGENTS else
+                               merge_stage(f"eval/{a}", len(plan.chunks), ckpt, store,
+                                           order=lambda _, tree: plan.to_run_order(tree)))
             if k_costs:
                 costs = in_loop_costs(cfg)[0]
-                results["in_loop"] = merge_stage("costs/in_loop", batch_count(len(es), costs_batch), ckpt, store,
-                                                 {"out": 1}, {"costs": costs})
+                results["in_loop"] = merge_stage("costs/in_loop", len(plans["costs/in_loop"].chunks), ckpt, store,
+                                                 {"out": 1}, {"costs": costs},
+                                                 order=lambda _, tree: plan.to_run_order(tree, axis=1))
             print(f"rollouts done in {time.perf_counter() - t0:.1f} s", file=sys.stderr)
-            results["episodes"] = es
+            results["episodes"] = bs.host_set()
             results["rollouts"] = rollouts
     if group.main:
         write_outputs(results, out)
@@ -287,5 +298,5 @@ def run_sweep(cfg: SweepConfig, studies: list[str], out: Path, *, resume: bool =
     return results if group.main else {}
 
 
-__all__ = ["REPO_SCENES", "SHIPPED_BENCHMARK", "benchmark_path", "costs_stage_parts", "eval_stage_parts",
-           "load_episodes", "merge_stage", "run_llm_stage", "run_sweep"]
+__all__ = ["REPO_SCENES", "SHIPPED_BENCHMARK", "benchmark_path", "load_episodes", "merge_stage",
+           "rollout_stage_parts", "run_llm_stage", "run_sweep"]

@@ -364,3 +364,30 @@ def test_every_study_has_one_report_section_in_the_same_order():
     from ignjax.sweep.report import SECTIONS
 
     assert tuple(SECTIONS) == STUDIES
+
+
+def test_sweep_in_buckets_writes_the_same_files(sweep_run, small_benchmark, tmp_path):
+    """The same sweep with a bank budget that splits the two scenes into two buckets, run one at a time: every
+    output is the same bytes, but for the lines recording eval.bank_mb itself."""
+    from ignjax.episodes.dataset import open_benchmark
+    from ignjax.evaluate.runner import plan_run
+    from ignjax.scenes.buckets import padded_bytes
+
+    bs = open_benchmark(small_benchmark["path"])
+    tight = (padded_bytes(bs.host.navgrids) - 1) / 2**20
+    assert len(plan_run(bs, 256, tight).buckets) == 2
+    cfg = resolve(None, _sets(small_benchmark["path"], sweep_run["root"]) + [f"eval.bank_mb={tight!r}"], quick=True)
+    out = tmp_path / "buckets"
+    run_sweep(cfg, ["eval", "costs", "difficulty", "derive-costs", "analysis"], out, quiet=True)
+    full = sweep_run["out"]
+    files = sorted(p.relative_to(full) for p in full.rglob("*") if p.is_file() and "checkpoints" not in p.parts)
+    assert files == sorted(p.relative_to(out) for p in out.rglob("*") if p.is_file() and "checkpoints" not in p.parts)
+    differ = [f for f in files if (full / f).read_bytes() != (out / f).read_bytes()]
+
+    def kept(lines):  # the configuration's bank_mb and the run's fingerprint, which hashes it
+        return [x for x in lines if "bank_mb" not in x and '"fingerprint"' not in x]
+
+    for f in differ:  # only where the configuration is recorded
+        a, b = ((d / f).read_text().splitlines() for d in (full, out))
+        assert kept(a) == kept(b), f
+    assert all("bank_mb" in (out / f).read_text() for f in differ)
