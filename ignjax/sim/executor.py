@@ -136,6 +136,42 @@ def _probe(world: World, s, xy, h, length):
 _OFFSETS = (0.0, 1.0, -1.0, 2.0, -2.0, 3.0, -3.0, 4.0)  # candidate headings, x 45 degrees: desired first, left first
 
 
+def first_free_alternative(world: World, s, xy, h0, need, chunk: int | None = None):
+    """The first free alternative heading of each row in ``need`` (rows whose
+    desired heading ``h0`` is blocked), probing :data:`_OFFSETS` ``[1:]`` in
+    order and only for the rows still without a free one: the same answer as
+    probing all seven for every such row and taking the first free, with
+    about a third of the probes (a row stops at its first free heading).
+
+    Args:
+        s, xy, h0: (B,) scene, (B, 2) position, (B,) desired heading.
+        need: (B,) bool rows to probe.
+
+    Returns:
+        (k (B,) int32, full (B,) bool): the index into :data:`_OFFSETS` of the
+        first free alternative (0 where none is free or the row is not in
+        ``need``) and whether its full micro-step is navigable.
+    """
+    cfg = world.config
+    B = need.shape[0]
+    offsets = jnp.array(_OFFSETS, jnp.float32) * (math.pi / 4)
+    step = jnp.float32(cfg.micro_step)
+
+    def cond(carry):
+        j, left = carry[0], carry[1]
+        return (j < len(_OFFSETS)) & jnp.any(left)
+
+    def body(carry):
+        j, left, k, full = carry
+        ok_j, full_j = masked_map(lambda a: _probe(world, a[0], a[1], a[2] + offsets[j], step), left, (s, xy, h0),
+                                  (jnp.zeros(B, bool), jnp.zeros(B, bool)), chunk)
+        return j + 1, left & ~ok_j, jnp.where(ok_j, j, k), jnp.where(ok_j, full_j, full)
+
+    init = (jnp.int32(1), need, jnp.zeros(B, jnp.int32), jnp.zeros(B, bool))
+    _, _, k, full = jax.lax.while_loop(cond, body, init)
+    return k, full
+
+
 def execute_moves(world: World, states: T.SimState, direction, col, row, mask, chunk: int | None = None):
     """Run the executor for the MOVEs of a batch (leading axis B).
 
@@ -144,9 +180,10 @@ def execute_moves(world: World, states: T.SimState, direction, col, row, mask, c
     the work its episodes need (:func:`ignjax.sim.compact.masked_map`):
     waypoints are cast for the rows in ``mask`` only, micro-steps run while
     any row is still moving, each micro-step probes the desired heading of
-    the moving rows and the seven neighbouring headings only of the rows
-    whose desired heading is blocked; each row takes the first free heading in
-    :data:`_OFFSETS` order, so a row's result does not depend on the others.
+    the moving rows and then the neighbouring headings in :data:`_OFFSETS`
+    order, each only for the rows still without a free one
+    (:func:`first_free_alternative`); each row takes the first free heading,
+    so a row's result does not depend on the others.
 
     Args:
         states: (B,) SimState.
@@ -167,7 +204,6 @@ def execute_moves(world: World, states: T.SimState, direction, col, row, mask, c
     wp = masked_map(lambda a: pixel_waypoint(world, *a)[0], mask, (s, pose0, direction, col, row), pose0[:, :2], chunk)
     yaw0 = pose0[:, 2]
     offsets = jnp.array(_OFFSETS, jnp.float32) * (math.pi / 4)
-    rows = jnp.arange(B)
 
     def cond(carry):
         i, active = carry[0], carry[-1]
@@ -181,18 +217,14 @@ def execute_moves(world: World, states: T.SimState, direction, col, row, mask, c
         len0 = jnp.minimum(cfg.micro_step, r)
         ok0, full0 = masked_map(lambda a: _probe(world, *a), active, (s, pose[:, :2], h0, len0),
                                 (jnp.zeros(B, bool), jnp.zeros(B, bool)), chunk)
-        alt = jax.vmap(lambda s_, xy, h: _probe(world, s_, xy, h, jnp.float32(cfg.micro_step)), in_axes=(None, None, 0))
-        ok_alt, full_alt = masked_map(lambda a: alt(a[0], a[1], a[2] + offsets[1:]), active & ~ok0, (s, pose[:, :2], h0),
-                                      (jnp.zeros((B, 7), bool), jnp.zeros((B, 7), bool)), chunk)
-        ok = jnp.concatenate([ok0[:, None], ok_alt], 1)
-        full = jnp.concatenate([full0[:, None], full_alt], 1)
-        k = jnp.argmax(ok, axis=1)
-        any_ok = jnp.any(ok, axis=1)
+        k, full_k = first_free_alternative(world, s, pose[:, :2], h0, active & ~ok0, chunk)
+        any_ok = ok0 | (k > 0)
+        full_k = jnp.where(ok0, full0, full_k)
         sec = sector_of(h0 - yaw0)
-        blocked = blocked.at[rows, sec].set(blocked[rows, sec] | (~ok0 & active))
+        blocked = blocked | ((sec[:, None] == jnp.arange(8)) & (~ok0 & active)[:, None])  # no scatter
         heading = h0 + offsets[k]
         lengths = jnp.where(k == 0, len0, jnp.float32(cfg.micro_step))
-        length = jnp.where(full[rows, k], lengths, 0.5 * lengths)
+        length = jnp.where(full_k, lengths, 0.5 * lengths)
         new_xy = pose[:, :2] + length[:, None] * jnp.stack([jnp.cos(heading), jnp.sin(heading)], 1)
         can = active & any_ok
         pose = jnp.where(can[:, None], jnp.concatenate([new_xy, heading[:, None]], 1), pose)

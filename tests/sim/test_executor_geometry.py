@@ -313,3 +313,32 @@ def test_every_micro_step_is_short_and_ends_navigable(room):
     assert (lengths > 1e-3).mean() >= 0.5  # most MOVEs did move
     assert np.isclose(lengths, world.config.micro_step, atol=1e-4).sum() >= 50  # full micro-steps are common
     assert n_blocked >= 5  # and obstacles were met on the way
+
+
+@pytest.mark.parametrize("chunk", [None, 5])
+def test_alternatives_probed_in_order_equal_probing_all_seven(room, chunk):
+    """The controller probes a blocked row's alternative headings in order,
+    stopping at the first free one: from 256 random navigable positions and
+    headings (many near a wall, the crate or the table), the first free
+    alternative and its full-step flag equal those of probing all seven for
+    every row, and rows outside the mask get none."""
+    world = room["world"]
+    grid = room["bank"].navgrids[0]
+    rng = np.random.default_rng(1)
+    pts = grid.navigable_points()
+    n = 256
+    xy = jnp.asarray(pts[rng.integers(len(pts), size=n)], jnp.float32)
+    h0 = jnp.asarray(rng.uniform(-math.pi, math.pi, n), jnp.float32)
+    s = jnp.zeros(n, jnp.int32)
+    need = jnp.asarray(rng.random(n) < 0.8)
+    k, full = jax.jit(lambda *a: X.first_free_alternative(world, *a, chunk))(s, xy, h0, need)
+
+    offsets = jnp.array(X._OFFSETS[1:], jnp.float32) * (math.pi / 4)
+    step = jnp.float32(world.config.micro_step)
+    every = jax.jit(jax.vmap(lambda s_, p, h: jax.vmap(lambda o: X._probe(world, s_, p, h + o, step))(offsets)))
+    ok, full_all = (np.asarray(a) for a in every(s, xy, h0))
+    want_k = np.where(ok.any(1) & np.asarray(need), ok.argmax(1) + 1, 0)
+    want_full = np.where(want_k > 0, full_all[np.arange(n), np.maximum(want_k - 1, 0)], False)
+    assert (want_k > 1).sum() >= 10 and (np.asarray(need) & ~ok.any(1)).sum() >= 1  # later alternatives, and none
+    np.testing.assert_array_equal(np.asarray(k), want_k)
+    np.testing.assert_array_equal(np.asarray(full), want_full)
