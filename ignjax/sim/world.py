@@ -206,15 +206,30 @@ def packed_at(world: World, table, n_groups: int, s, xy):
     return jnp.where(inside, bits, jnp.uint32(0))
 
 
+def first_occupied(occupied, xy, heading, step: float, start: int, stop: int):
+    """() int32 index of the first of samples ``start .. stop - 1`` (sample
+    ``i`` at ``(i + 1) * step`` along a horizontal ray) where ``occupied``
+    ((n, 2) points -> (n,) bool) holds; ``stop`` when none does."""
+    t = jnp.arange(start + 1, stop + 1, dtype=jnp.float32) * step
+    pts = xy[None] + t[:, None] * jnp.stack([jnp.cos(heading), jnp.sin(heading)])[None]
+    hit = occupied(pts)
+    return jnp.where(jnp.any(hit), start + jnp.argmax(hit).astype(jnp.int32), jnp.int32(stop))
+
+
+def free_of_index(i, max_dist: float, step: float):
+    """The free distance of a fixed-step march (:func:`march_free`) whose
+    first occupied sample has index ``i`` (``ceil(max_dist / step)``: none)."""
+    n = int(math.ceil(max_dist / step))
+    t = jnp.arange(1, n + 1, dtype=jnp.float32) * step  # the samples' distances, as first_occupied computes them
+    return jnp.where(i < n, t[jnp.clip(i, 0, n - 1)] - step, jnp.float32(max_dist))
+
+
 def march_free(occupied, xy, heading, max_dist: float, step: float):
     """Free distance along a horizontal ray: the distance of the last sample
     before the first one where ``occupied`` ((n, 2) points -> (n,) bool) holds
     (``max_dist`` when none is within range); fixed steps of ``step``."""
     n = int(math.ceil(max_dist / step))
-    t = jnp.arange(1, n + 1, dtype=jnp.float32) * step
-    pts = xy[None] + t[:, None] * jnp.stack([jnp.cos(heading), jnp.sin(heading)])[None]
-    hit = occupied(pts)
-    return jnp.where(jnp.any(hit), t[jnp.argmax(hit)] - step, jnp.float32(max_dist))
+    return free_of_index(first_occupied(occupied, xy, heading, step, 0, n), max_dist, step)
 
 
 def probe_free(world: World, s, xy, heading, mask: int, max_dist: float, step: float):
