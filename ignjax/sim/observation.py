@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
@@ -15,14 +16,26 @@ import jax.numpy as jnp
 from ignjax.scenes import vocab
 from ignjax.sim import geometry as G
 from ignjax.sim import types as T
+from ignjax.sim.rays import queries as SR
 from ignjax.sim.compact import masked_map
-from ignjax.sim.queries import instance_in_sight, room_at, sector_of
+from ignjax.sim.queries import SIGHT_POINTS, instance_in_sight, room_at, sector_of, sight_lines, sight_samples
 from ignjax.sim.world import World, first_occupied, free_of_index, march_free, packed_at
 
 
-FREE_FIRST = 1 / 3
-"""Share of a free-space ray's samples that :func:`observe_batch` marches
-for every ray; only the rays with no obstacle within it march the rest."""
+FIRST_PASS = 1 / 3
+"""Share of a free-space ray's or a sight line's samples that
+:func:`sight_batch` marches for every ray; only the rays with nothing in
+the way within it (and, for a sight line, still short of the instance) march
+the rest."""
+
+
+class Sight(NamedTuple):
+    """One pose's ray-cast perception, before any perception noise."""
+
+    free_space: jax.Array  # (8, R) free-space rays, m
+    nearest: jax.Array  # (K,) int32 the K nearest non-structural instances within range
+    distance: jax.Array  # (K,) their horizontal distances, +inf beyond range
+    in_sight: jax.Array  # (K,) bool nothing blocks every sight line to it (and it lies within range)
 
 
 def _ray_headings(cfg: T.SimConfig, yaw):
@@ -39,62 +52,117 @@ def _free_occupied(world: World, s):
     return lambda p: packed_at(world, world.packed_obs, 2, s, p) != 0
 
 
-def _free_samples(world: World) -> int:
-    return int(math.ceil(world.config.obs_range / (2 * world.bank.grid.resolution)))
-
-
-def free_space_batch(world: World, states: T.SimState, mask, chunk: int | None = None):
-    """(B, 8, R) free-space rays of the rows in ``mask`` (others 0): the same
-    values as :func:`observe`'s, in two passes. Every ray marches its first
-    :data:`FREE_FIRST` of the samples; the rays with no obstacle there
-    (most meet one within 2 m) march the rest, compacted
-    (:func:`ignjax.sim.compact.masked_map`), instead of every ray taking
-    every sample. Exact: each sample is the same computation."""
-    cfg = world.config
+def _free_samples(world: World) -> tuple[float, int]:
+    """(step, samples) of a free-space ray: every two navigation cells up to ``obs_range``."""
     step = 2 * world.bank.grid.resolution
-    n = _free_samples(world)
-    first = max(1, min(n, int(round(n * FREE_FIRST))))
+    return step, int(math.ceil(world.config.obs_range / step))
+
+
+def _first_pass(n: int) -> int:
+    return max(1, min(n, int(round(n * FIRST_PASS))))
+
+
+def _nearest(world: World, s, pose):
+    """(K,) the K nearest non-structural instances within ``obs_range`` and their horizontal distances."""
+    cfg = world.config
+    inst = world.bank.instances
+    cand = inst.valid[s] & ~inst.structural[s]
+    d = jnp.linalg.norm(inst.center[s, :, :2] - pose[None, :2], axis=1)
+    d = jnp.where(cand & (d <= cfg.obs_range), d, jnp.inf)
+    K = min(cfg.max_visible, inst.valid.shape[1])
+    neg, idx = jax.lax.top_k(-d, K)
+    return idx, -neg
+
+
+def _eye(cfg: T.SimConfig, pose):
+    return jnp.array([pose[0], pose[1], cfg.eye_height], jnp.float32)
+
+
+def sight_of(world: World, state: T.SimState) -> Sight:
+    """One episode's :class:`Sight`: every ray marched to its end."""
+    cfg = world.config
+    s, pose = state.episode.scene, state.pose
+    step, n = _free_samples(world)
+    free_space = jax.vmap(jax.vmap(lambda h: march_free(_free_occupied(world, s), pose[:2], h, cfg.obs_range,
+                                                        step)))(_ray_headings(cfg, pose[2]))
+    idx, dist = _nearest(world, s, pose)
+    eye = _eye(cfg, pose)
+    seen = jax.vmap(lambda i: instance_in_sight(world, s, i, eye))(idx) & jnp.isfinite(dist)
+    return Sight(free_space, idx, dist, seen)
+
+
+def sight_batch(world: World, states: T.SimState, mask, chunk: int | None = None) -> Sight:
+    """The :class:`Sight` of the rows in ``mask`` of a batch (leading axis B;
+    other rows' rays read 0 / False), the same values as :func:`sight_of`'s,
+    marched in two passes. Every free-space ray and sight line takes its
+    first :data:`FIRST_PASS` of the samples; only the rays still clear, and
+    for a sight line still short of the instance's box, take the rest,
+    compacted (:func:`ignjax.sim.compact.masked_map`); a sight line is not
+    marched further when the instance's other sight line is already clear,
+    nor at all for an instance out of range. Exact: each sample is the same
+    computation, and a ray's answer is decided by its first occupied sample."""
+    cfg = world.config
+    rays = world.bank.rays
+    f_step, f_n = _free_samples(world)
+    l_step, l_n = sight_samples(world)
+    f_first, l_first = _first_pass(f_n), _first_pass(l_n)
     s, pose = states.episode.scene, states.pose
-    heads = jax.vmap(lambda yaw: _ray_headings(cfg, yaw))(pose[:, 2])  # Shape: (B, 8, R)
-    B, V, R = heads.shape
+    B = s.shape[0]
+    V, R = 8, cfg.obs_rays_per_view
+    K = min(cfg.max_visible, world.bank.instances.valid.shape[1])
 
-    def near(a):
-        s_, xy, h = a
-        return jax.vmap(jax.vmap(lambda h_: first_occupied(_free_occupied(world, s_), xy, h_, step, 0, first)))(h)
+    def first_pass(a):
+        s_, pose_ = a
+        heads = _ray_headings(cfg, pose_[2])
+        i1 = jax.vmap(jax.vmap(lambda h: first_occupied(_free_occupied(world, s_), pose_[:2], h, f_step, 0, f_first)))(heads)
+        idx, dist = _nearest(world, s_, pose_)
+        eye = _eye(cfg, pose_)
+        u, limit = jax.vmap(lambda i: sight_lines(world, s_, i, eye))(idx)  # Shape: (K, 2, 3), (K, 2)
+        b1 = jax.vmap(jax.vmap(lambda u_, l_: SR.segment_blocked(rays, s_, eye, u_, l_, l_step, 0, l_first)))(u, limit)
+        return heads, i1, idx, dist, u, limit, b1
 
-    i1 = masked_map(near, mask, (s, pose[:, :2], heads), jnp.full((B, V, R), n, jnp.int32), chunk)
-    far = (mask[:, None, None] & (i1 == first)).reshape(-1)
-    rays = (jnp.repeat(s, V * R), jnp.repeat(pose[:, :2], V * R, axis=0), heads.reshape(-1))
-    i = masked_map(lambda a: first_occupied(_free_occupied(world, a[0]), a[1], a[2], step, first, n), far, rays,
+    default = (jnp.zeros((B, V, R), jnp.float32), jnp.full((B, V, R), f_n, jnp.int32), jnp.zeros((B, K), jnp.int32),
+               jnp.full((B, K), jnp.inf, jnp.float32), jnp.zeros((B, K, SIGHT_POINTS, 3), jnp.float32),
+               jnp.zeros((B, K, SIGHT_POINTS), jnp.float32), jnp.zeros((B, K, SIGHT_POINTS), bool))
+    heads, i1, idx, dist, u, limit, b1 = masked_map(first_pass, mask, (s, pose), default, chunk)
+
+    # free-space rays with no obstacle in the first pass march the rest
+    far = (mask[:, None, None] & (i1 == f_first)).reshape(-1)
+    args = (jnp.repeat(s, V * R), jnp.repeat(pose[:, :2], V * R, axis=0), heads.reshape(-1))
+    i = masked_map(lambda a: first_occupied(_free_occupied(world, a[0]), a[1], a[2], f_step, f_first, f_n), far, args,
                    i1.reshape(-1), None if chunk is None else chunk * V * R)
-    return jnp.where(mask[:, None, None], free_of_index(i.reshape(B, V, R), cfg.obs_range, step), 0.0)
+    free_space = jnp.where(mask[:, None, None], free_of_index(i.reshape(B, V, R), cfg.obs_range, f_step), 0.0)
+
+    # sight lines still clear and short of the box march the rest, unless the other line is already clear
+    live = (mask[:, None] & jnp.isfinite(dist))[..., None] & ~b1
+    more = limit >= (jnp.arange(1, l_n + 1, dtype=jnp.float32) * l_step)[l_first]  # the next sample is checked
+    clear = live & ~more
+    need = live & more & ~jnp.any(clear, axis=-1, keepdims=True)
+    P = K * SIGHT_POINTS
+    eyes = jax.vmap(lambda p: _eye(cfg, p))(pose)
+    args = (jnp.repeat(s, P), jnp.repeat(eyes, P, axis=0), u.reshape(-1, 3), limit.reshape(-1))
+    b2 = masked_map(lambda a: SR.segment_blocked(rays, a[0], a[1], a[2], a[3], l_step, l_first, l_n),
+                    need.reshape(-1), args, jnp.zeros(B * P, bool), None if chunk is None else chunk * P)
+    clear = clear | (need & ~b2.reshape(need.shape))
+    valid = jax.vmap(lambda s_, i_: world.bank.instances.valid[s_, i_])(s, idx)
+    in_sight = jnp.any(clear, axis=-1) & valid & jnp.isfinite(dist) & mask[:, None]
+    return Sight(free_space, idx, dist, in_sight)
 
 
-def observe(world: World, state: T.SimState, free_space=None) -> T.Observation:
+def observe(world: World, state: T.SimState, sight: Sight | None = None) -> T.Observation:
     """What the policy sees (no target identity, pose or distance inside).
     Perception is exact unless ``SimConfig.miss_rate`` / ``confusion_rate``
-    make it noisy (:func:`perception_noise`). ``free_space``: the (8, R)
-    free-space rays if already computed (:func:`free_space_batch`)."""
+    make it noisy (:func:`perception_noise`). ``sight``: the pose's
+    :class:`Sight` if already computed (:func:`sight_batch`), else :func:`sight_of`."""
     with jax.named_scope("observe"):
         cfg = world.config
         bank = world.bank
-        ep = state.episode
-        s = ep.scene
+        s = state.episode.scene
         pose = state.pose
-        res = bank.grid.resolution
-        if free_space is None:
-            free_space = jax.vmap(jax.vmap(lambda h: march_free(_free_occupied(world, s), pose[:2], h, cfg.obs_range,
-                                                                2 * res)))(_ray_headings(cfg, pose[2]))
+        free_space, idx, dist, seen = sight_of(world, state) if sight is None else sight
         # visible instances: K nearest non-structural instances, kept when in sight
         inst = bank.instances
-        cand = inst.valid[s] & ~inst.structural[s]
-        d = jnp.linalg.norm(inst.center[s, :, :2] - pose[None, :2], axis=1)
-        d = jnp.where(cand & (d <= cfg.obs_range), d, jnp.inf)
-        K = min(cfg.max_visible, inst.valid.shape[1])
-        neg, idx = jax.lax.top_k(-d, K)
-        dist = -neg
-        eye = jnp.array([pose[0], pose[1], cfg.eye_height], jnp.float32)
-        seen = jax.vmap(lambda i: instance_in_sight(world, s, i, eye))(idx) & jnp.isfinite(dist)
+        K = idx.shape[0]
         bearing = G.wrap_angle(jnp.arctan2(inst.center[s, idx, 1] - pose[1], inst.center[s, idx, 0] - pose[0]) - pose[2])
         attrs = jnp.stack([inst.color[s, idx], inst.material[s, idx], inst.size[s, idx], inst.state[s, idx]], -1)
         if cfg.miss_rate > 0 or cfg.confusion_rate > 0:
@@ -177,8 +245,8 @@ def observe_batch(world: World, states: T.SimState, previous: T.Observation, mov
     perception (rays, visible instances, room) is recomputed for the rows in
     ``moved`` only; every other row's pose is unchanged, so it keeps
     ``previous``'s perception with its state fields refreshed. The free-space
-    rays of the moved rows are marched together first (:func:`free_space_batch`).
+    rays and sight lines of the moved rows are marched together first (:func:`sight_batch`).
     Row for row the same as ``vmap(observe)``."""
-    free = free_space_batch(world, states, moved, chunk)
-    obs = masked_map(lambda a: observe(world, *a), moved, (states, free), previous, chunk)
+    sight = sight_batch(world, states, moved, chunk)
+    obs = masked_map(lambda a: observe(world, *a), moved, (states, sight), previous, chunk)
     return dataclasses.replace(obs, **jax.vmap(lambda st: state_fields(world, st))(states))

@@ -70,10 +70,15 @@ def sector_of(rel):
     return (jnp.round(G.wrap_angle(rel) / (math.pi / 4)).astype(jnp.int32)) % 8
 
 
-def instance_in_sight(world: World, s, i, eye):
-    """() bool: nothing blocks the view from ``eye`` to instance i's box
-    (its centre or top centre) before the ray enters the box."""
-    cfg = world.config
+SIGHT_POINTS = 2
+"""Points of an instance a sight line may reach: its box centre, then near its top."""
+
+
+def sight_lines(world: World, s, i, eye):
+    """The sight lines from ``eye`` to instance i (:data:`SIGHT_POINTS` of
+    them: its box centre and near its top), each checked until it enters the
+    box: (u (2, 3) unit directions, limit (2,) lengths checked), for
+    :func:`ignjax.sim.rays.queries.segment_blocked`."""
     inst = world.bank.instances
     c = inst.center[s, i]
     h = inst.half_extents[s, i]
@@ -86,6 +91,21 @@ def instance_in_sight(world: World, s, i, eye):
         u = d / jnp.maximum(L, 1e-6)
         t_in = SR.box_entry(eye, u, c, h, yaw)
         before = L - jnp.minimum(t_in, L) + 0.06
-        return SR.segment_clear(world.bank.rays, s, eye, p, before, cfg.obs_range + 1.0, world.bank.grid.resolution * 2)
+        return SR.segment_ray(eye, p, before)
 
-    return jnp.any(jax.vmap(one)(pts)) & inst.valid[s, i]
+    return jax.vmap(one)(pts)
+
+
+def sight_samples(world: World) -> tuple[float, int]:
+    """(step, samples) of a sight line's march: every two navigation cells up to ``obs_range + 1`` m."""
+    step = world.bank.grid.resolution * 2
+    return step, int(math.ceil((world.config.obs_range + 1.0) / step))
+
+
+def instance_in_sight(world: World, s, i, eye):
+    """() bool: nothing blocks the view from ``eye`` to instance i's box
+    (its centre or top centre) before the ray enters the box."""
+    step, n = sight_samples(world)
+    u, limit = sight_lines(world, s, i, eye)
+    blocked = jax.vmap(lambda u_, l_: SR.segment_blocked(world.bank.rays, s, eye, u_, l_, step, 0, n))(u, limit)
+    return jnp.any(~blocked) & world.bank.instances.valid[s, i]

@@ -191,6 +191,30 @@ def march(grid: RayGrid, scene, pnt, vec, max_dist, *, static_range: float, outs
     return jnp.where(jnp.isinf(hit) & jnp.isfinite(t_floor) & (t_floor <= max_dist), t_floor, hit)
 
 
+def segment_ray(a, b, stop_before):
+    """The direction and checked length of the segment from ``a`` towards
+    ``b`` that :func:`segment_clear` marches: (u (3,) unit, limit ())
+    with ``limit = |b - a| - stop_before``."""
+    d = b - a
+    length = jnp.linalg.norm(d)
+    return d / jnp.maximum(length, 1e-6), length - stop_before
+
+
+def segment_blocked(grid: RayGrid, scene, a, u, limit, step: float, start: int, stop: int):
+    """() bool: one of samples ``start .. stop - 1`` of the march from ``a``
+    along ``u`` (sample ``i`` at ``(i + 1) * step``) within ``limit`` lies in
+    an occupied voxel or below the floor (:func:`segment_clear`'s test)."""
+    t = (jnp.arange(start + 1, stop + 1, dtype=jnp.float32)) * step
+    use = t <= limit
+    p = a[None] + t[:, None] * u[None]
+    res = grid.resolution
+    col = jnp.floor((p[:, 0] - grid.origin[scene, 0]) / res).astype(jnp.int32)
+    row = jnp.floor((p[:, 1] - grid.origin[scene, 1]) / res).astype(jnp.int32)
+    k = jnp.floor(p[:, 2] / grid.slice_height).astype(jnp.int32)
+    occ = _occupied(grid, scene, k, row, col) | (p[:, 2] < 0)
+    return jnp.any(occ & use)
+
+
 def segment_clear(grid: RayGrid, scene, a, b, stop_before, max_len: float, step: float):
     """Whether the segment from ``a`` towards ``b`` is free up to
     ``|b - a| - stop_before`` (fixed-step 3-D march, floor included).
@@ -208,19 +232,8 @@ def segment_clear(grid: RayGrid, scene, a, b, stop_before, max_len: float, step:
     Returns:
         () bool.
     """
-    n = int(math.ceil(max_len / step))
-    d = b - a
-    length = jnp.linalg.norm(d)
-    u = d / jnp.maximum(length, 1e-6)
-    t = (jnp.arange(1, n + 1, dtype=jnp.float32)) * step
-    use = t <= length - stop_before
-    p = a[None] + t[:, None] * u[None]
-    res = grid.resolution
-    col = jnp.floor((p[:, 0] - grid.origin[scene, 0]) / res).astype(jnp.int32)
-    row = jnp.floor((p[:, 1] - grid.origin[scene, 1]) / res).astype(jnp.int32)
-    k = jnp.floor(p[:, 2] / grid.slice_height).astype(jnp.int32)
-    occ = _occupied(grid, scene, k, row, col) | (p[:, 2] < 0)
-    return ~jnp.any(occ & use)
+    u, limit = segment_ray(a, b, stop_before)
+    return ~segment_blocked(grid, scene, a, u, limit, step, 0, int(math.ceil(max_len / step)))
 
 
 def box_entry(a, u, center, half, yaw):
