@@ -5,8 +5,11 @@
   sub-box tests and exact confirmation against the voxel's primitives. Its
   cost under ``vmap`` is the same for every ray; it agrees with ``mj_ray``
   within one grid cell on >= 99.5% of random rays (``tests/test_sim.py``).
+  :func:`march_begin` and :func:`march_resume` are the same march cut in
+  two, so that a batch resumes only the rays its first steps left open.
 * :func:`segment_clear` - line of sight for visibility: a fixed-step march
-  over the voxel occupancy (``voxcode <= 1``, a conservative voxelization).
+  over the voxel occupancy (``voxcode <= 1``, a conservative voxelization);
+  :func:`segment_blocked` is its test over any range of samples.
 * :func:`box_entry` - where a ray enters an upright oriented box.
 
 The collision and free-space probes of the controller read the per-scene
@@ -17,6 +20,7 @@ path for large ray batches is :func:`ignjax.sim.rays.fast.fast_rays`.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
@@ -90,6 +94,27 @@ def march(grid: RayGrid, scene, pnt, vec, max_dist, *, static_range: float, outs
     Returns:
         () float32 distance, +inf when nothing is hit within ``max_dist``.
     """
+    return march_resume(grid, scene, pnt, vec, max_dist, march_begin(
+        grid, scene, pnt, vec, max_dist, static_range=static_range, outside_hits=outside_hits,
+        include_floor=include_floor, exact=exact, iterations=iterations, steps=0),
+        static_range=static_range, outside_hits=outside_hits, include_floor=include_floor, exact=exact,
+        iterations=iterations, steps=0)
+
+
+class MarchState(NamedTuple):
+    """A :func:`march` stopped after the first steps of its traversal
+    (:func:`march_begin`): the traversal's carry, and whether the answer is
+    already known (``done``, the distance ``value``)."""
+
+    carry: tuple
+    done: jax.Array
+    value: jax.Array
+
+
+def _march_parts(grid: RayGrid, scene, pnt, vec, max_dist, *, static_range: float, outside_hits: bool,
+                 include_floor: bool, exact: int, iterations: int | None):
+    """The pieces of :func:`march`, recomputed alike by each of its parts:
+    (iteration count, traversal body, exact test, first carry, finish)."""
     res, sh = grid.resolution, grid.slice_height
     n_iter = int(math.ceil(static_range * (math.sqrt(2.0) / res + 1.0 / sh))) + 3 if iterations is None else iterations
     inf = jnp.float32(jnp.inf)
@@ -167,28 +192,81 @@ def march(grid: RayGrid, scene, pnt, vec, max_dist, *, static_range: float, outs
         th = jnp.where((j < count) & (ids >= 0) & (th >= t0 - 1e-5) & (th <= t1 + 1e-5), th, inf)
         return jnp.maximum(jnp.min(th), 0.0), rough
 
-    state = (cell, t_max, jnp.float32(0.0))
-    zero3 = jnp.zeros(3, jnp.int32)
+    first = (cell, t_max, jnp.float32(0.0), inf, jnp.zeros(3, jnp.int32), jnp.float32(0.0), jnp.float32(0.0),
+             jnp.array(False))
+
+    def finish(result):
+        hit = jnp.where(result <= limit, result, inf)
+        return jnp.where(jnp.isinf(hit) & jnp.isfinite(t_floor) & (t_floor <= max_dist), t_floor, hit)
+
+    def moving(carry):  # the traversal would still step: nothing hit yet and within range
+        return jnp.isinf(carry[3]) & (carry[2] <= limit)
+
+    return n_iter, body, exact_test, first, finish, moving
+
+
+def _round(exact_test, exact: int, r: int, rounds: int, carry, pending, result):
+    """The end of round ``r`` of :func:`march`'s traversal: a hit found is
+    confirmed exactly (or kept, in the last round). Returns (result, pending)."""
+    hit, h_ci, h_t0, h_t1, h_rough = carry[3:]
+    found = pending & jnp.isfinite(hit)
+    if exact:
+        t_ex, rough = exact_test(h_ci, h_t0, h_t1)
+        rough = rough | h_rough
+        accept = found & (rough | jnp.isfinite(t_ex) | (r == rounds - 1))  # the last round keeps a sub-box hit
+        value = jnp.where(rough | ~jnp.isfinite(t_ex), hit, t_ex)
+    else:
+        accept, value = found, hit
+    return jnp.where(accept, value, result), found & ~accept
+
+
+def march_begin(grid: RayGrid, scene, pnt, vec, max_dist, *, static_range: float, outside_hits: bool,
+                include_floor: bool = True, exact: int = 0, iterations: int | None = None,
+                steps: int) -> MarchState:
+    """The first ``steps`` traversal steps of :func:`march` (same arguments),
+    and whether they decide the answer: a hit confirmed (or kept) in the
+    first round, or a ray past its range or out of the grid with nothing hit.
+    :func:`march_resume` continues it; a batch resumes only its rays not
+    ``done`` (each step is the same computation, so the answer is
+    :func:`march`'s)."""
+    n_iter, body, exact_test, carry, finish, moving = _march_parts(
+        grid, scene, pnt, vec, max_dist, static_range=static_range, outside_hits=outside_hits,
+        include_floor=include_floor, exact=exact, iterations=iterations)
+    if steps == 0:
+        return MarchState(carry, jnp.array(False), jnp.float32(jnp.inf))
+    carry = jax.lax.fori_loop(0, min(steps, n_iter), body, carry)
     rounds = EXACT_ROUNDS if exact else 1
-    result, pending = inf, jnp.array(True)
+    result, pending = _round(exact_test, exact, 0, rounds, carry, jnp.array(True), jnp.float32(jnp.inf))
+    hit = carry[3]
+    # nothing hit and no step left to take (beyond the range or the floor, out of the grid): no later step
+    # changes it; or a hit the first round keeps
+    idle = jnp.isinf(hit) & (~moving(carry) | (steps >= n_iter))
+    done = (jnp.isfinite(hit) & ~pending) | idle
+    return MarchState(carry, done, finish(result))
+
+
+def march_resume(grid: RayGrid, scene, pnt, vec, max_dist, state: MarchState, *, static_range: float,
+                 outside_hits: bool, include_floor: bool = True, exact: int = 0, iterations: int | None = None,
+                 steps: int) -> jax.Array:
+    """:func:`march`'s distance, from the state :func:`march_begin` left after ``steps`` steps."""
+    n_iter, body, exact_test, _, finish, _ = _march_parts(
+        grid, scene, pnt, vec, max_dist, static_range=static_range, outside_hits=outside_hits,
+        include_floor=include_floor, exact=exact, iterations=iterations)
+    rounds = EXACT_ROUNDS if exact else 1
+    carry = state.carry
+    result, pending = jnp.float32(jnp.inf), jnp.array(True)
     for r in range(rounds):
-        n_r = n_iter if r == 0 else max(n_iter // 4, 1)
-        carry = (*state, inf, zero3, jnp.float32(0.0), jnp.float32(0.0), jnp.array(False))
-        cell, t_max, t_cur, hit, h_ci, h_t0, h_t1, h_rough = jax.lax.fori_loop(0, n_r, body, carry)
-        state = (cell, t_max, t_cur)
-        found = pending & jnp.isfinite(hit)
-        if exact:
-            t_ex, rough = exact_test(h_ci, h_t0, h_t1)
-            rough = rough | h_rough
-            last = r == rounds - 1
-            accept = found & (rough | jnp.isfinite(t_ex) | last)  # the last round keeps a sub-box hit
-            value = jnp.where(rough | ~jnp.isfinite(t_ex), hit, t_ex)
+        if r == 0:
+            carry = jax.lax.fori_loop(min(steps, n_iter), n_iter, body, carry)
         else:
-            accept, value = found, hit
-        result = jnp.where(accept, value, result)
-        pending = found & ~accept
-    hit = jnp.where(result <= limit, result, inf)
-    return jnp.where(jnp.isinf(hit) & jnp.isfinite(t_floor) & (t_floor <= max_dist), t_floor, hit)
+            carry = jax.lax.fori_loop(0, max(n_iter // 4, 1), body, (*carry[:3], *_fresh(carry)))
+        result, pending = _round(exact_test, exact, r, rounds, carry, pending, result)
+    return finish(result)
+
+
+def _fresh(carry):
+    """A new round's hit record (nothing hit yet)."""
+    return (jnp.float32(jnp.inf), jnp.zeros(3, jnp.int32), jnp.float32(0.0), jnp.float32(0.0), jnp.array(False))
 
 
 def segment_ray(a, b, stop_before):
