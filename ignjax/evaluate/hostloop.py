@@ -192,7 +192,7 @@ def _reset_all(world, specs, keys):
 @jax.jit
 def _step_rows(world, states, actions, mask):
     """Step the rows in ``mask`` (the others stay as they are) and their trajectory records."""
-    obs = jax.vmap(lambda s: E.observe(world, s))(states)
+    obs = E.observe_all(world, states)
     after = T.tree_select(mask, E.step_batch(world, states, actions), states)
     kind = jnp.where(states.done | ~mask, -1, jnp.clip(actions.kind, 0, 2))
     return after, step_record(obs, actions, kind, states, after, world.config.n_views)
@@ -206,7 +206,7 @@ def _abort_rows(states, mask):
 
 @jax.jit
 def _observe_rows(world, states):
-    return jax.vmap(lambda s: E.observe(world, s))(states)
+    return E.observe_all(world, states)
 
 
 @jax.jit

@@ -75,7 +75,7 @@ from ignjax.errors import ConfigError
 from ignjax.sim import types as T
 from ignjax.sim.compact import masked_map
 from ignjax.sim.executor import execute_moves, pixel_waypoint
-from ignjax.sim.observation import observe, observe_batch
+from ignjax.sim.observation import observe, observe_all, observe_batch
 from ignjax.sim.oracle import ask, describe_upfront, hint_progress
 from ignjax.sim.queries import euclidean_to_target, geodesic_to_target
 from ignjax.sim.world import World
@@ -256,6 +256,6 @@ def check_specs(world: World, specs: T.EpisodeSpec) -> None:
 
 
 __all__ = [
-    "reset", "step", "step_batch", "sanitize_action", "observe", "observe_batch", "outcome", "privileged_info", "check_action",
+    "reset", "step", "step_batch", "sanitize_action", "observe", "observe_all", "observe_batch", "outcome", "privileged_info", "check_action",
     "check_specs",
 ]

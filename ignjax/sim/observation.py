@@ -240,6 +240,13 @@ def state_fields(world: World, state: T.SimState) -> dict:
     )
 
 
+def observe_all(world: World, states: T.SimState, chunk: int | None = None) -> T.Observation:
+    """:func:`observe` of every row of a batch (leading axis B), the rays
+    marched together in two passes (:func:`sight_batch`)."""
+    sight = sight_batch(world, states, jnp.ones(states.pose.shape[0], bool), chunk)
+    return jax.vmap(lambda st, si: observe(world, st, si))(states, sight)
+
+
 def observe_batch(world: World, states: T.SimState, previous: T.Observation, moved, chunk: int | None = None) -> T.Observation:
     """:func:`observe` of a batch (leading axis B) after a step: the
     perception (rays, visible instances, room) is recomputed for the rows in
