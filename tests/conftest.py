@@ -5,9 +5,7 @@ skip with the reason when it is absent. The core suite never needs it.
 
 The session runs with two CPU devices (``ignjax.devices.configure_cpu_devices``,
 set here before JAX starts; ``IGNJAX_CPU_DEVICES`` overrides the count), so
-rollouts are sharded over two devices unless a test says otherwise. It
-shares one JAX persistent compilation cache (a temporary folder, unless
-``JAX_COMPILATION_CACHE_DIR`` is set) with the subprocesses its tests start.
+rollouts are sharded over two devices unless a test says otherwise.
 
 ``two_room_scene``: a small hand-built scene (living room + bedroom, one
 door) with known instances, for tests that need exact expectations.
@@ -15,11 +13,8 @@ door) with known instances, for tests that need exact expectations.
 
 from __future__ import annotations
 
-import atexit
 import math
 import os
-import shutil
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -27,13 +22,6 @@ import pytest
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
-if "JAX_COMPILATION_CACHE_DIR" not in os.environ:
-    # one persistent compilation cache for the session, set before JAX starts: the rollouts that tests in
-    # several modules compile alike, and those of the command-line runs the tests start as subprocesses
-    # (which inherit the variable), compile once; removed when the session ends
-    _JAX_CACHE = tempfile.mkdtemp(prefix="ignjax-tests-jax-cache-")
-    os.environ["JAX_COMPILATION_CACHE_DIR"] = _JAX_CACHE
-    atexit.register(shutil.rmtree, _JAX_CACHE, True)
 
 from ignjax.devices import configure_cpu_devices  # noqa: E402
 
