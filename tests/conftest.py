@@ -28,6 +28,39 @@ from ignjax.devices import configure_cpu_devices  # noqa: E402
 configure_cpu_devices(2)
 
 ROOT = Path(__file__).resolve().parents[1]
+MAP_SHARE = 3
+"""Compiled programs are dropped after a test file once the process holds
+more than 1/MAP_SHARE of the kernel's memory-mapping limit (below)."""
+
+
+def _map_counts() -> tuple[int, int] | None:
+    """(memory mappings of this process, the kernel's limit), or None where /proc does not tell."""
+    try:
+        with open("/proc/self/maps", "rb") as f:
+            n = sum(1 for _ in f)
+        return n, int(Path("/proc/sys/vm/max_map_count").read_text())
+    except (OSError, ValueError):
+        return None
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _drop_compiled_programs():
+    """Every program XLA:CPU compiles holds about three memory mappings of
+    its own (code, constants, data) for as long as JAX's caches keep it, and
+    the whole suite compiles thousands in one process: past the kernel's
+    ``vm.max_map_count`` (65,530 by default) the next compile's ``mmap``
+    fails and the process dies with a segmentation fault. After a test file,
+    once the mappings pass a third of the limit, JAX's caches are cleared
+    (``jax.clear_caches``), which frees them; a later file compiles again what it needs."""
+    yield
+    counts = _map_counts()
+    if counts and counts[0] * MAP_SHARE > counts[1]:
+        import gc
+
+        import jax
+
+        jax.clear_caches()
+        gc.collect()
 SHARED_DATA = Path(os.environ.get("IGNJAX_SHARED_DATA", ROOT.parent / "shared" / "data"))
 
 
