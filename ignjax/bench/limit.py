@@ -225,8 +225,7 @@ def step_work(world, specs, agent, params, keys) -> dict:
 
     parts = R.batch_parts()
     n = specs.scene.shape[0]
-    widths = R._shard_widths(n, 1, parts, None)
-    share = R._shard_rows(n, 1, parts, widths)  # one device's rows: the program each device runs
+    share, widths = R.shard_layout(n, parts)  # one device's rows: the program each device runs
     specs, keys = R.pad_batch(specs, keys, share * parts)
     specs, keys = jax.tree.map(lambda a: a[:share], specs), keys[:share]
     run = counted_program(lambda w, s, p, k: R._rollout(w, s, agent, p, k, widths), world, specs, params, keys)

@@ -32,6 +32,11 @@ process, on the same inputs:
   (``"gather"``, ``"bandwidth"`` or ``"compute"``) and the fraction of it
   the decision-steps figure reaches; the top-level ``steps_per_s``,
   ``bound`` and ``fraction`` are the EIG agent's.
+* **pieces** - where a decision step's time goes (:mod:`ignjax.bench.pieces`):
+  microseconds per decision step of the agent, the waypoints, the
+  controller's probes, the oracle, the rest of the step and the
+  observation, each run as a program of its own on one device's share of
+  the B = 4096 rollouts, beside that share's fused rollout (``whole``).
 * **compile_s** - first call of the EIG agent's rollout at B = 256.
 * **studies** - offline WSR of 10^6 cost vectors x 500 episodes, and the
   in-the-loop sweep (the EIG agent under K cost vectors x 500 episodes in
@@ -40,6 +45,7 @@ process, on the same inputs:
 
 ``--json``: the last line of stdout is one JSON object with every figure.
 ``--llm``: only the MLLM host loop's figures (:mod:`ignjax.bench.llm`).
+``--pieces``: only the ``pieces`` block.
 ``--scaling``: only how cost grows (:mod:`ignjax.bench.scaling`): steps/s and
 memory against batch size, scenes in the bank, devices and cost vectors, as
 ``scaling.png`` and ``scaling.json`` in ``--out``.
@@ -71,6 +77,9 @@ def main(argv=None) -> int:
     p.add_argument("--llm", action="store_true",
                    help="only the MLLM loop's figures (the llm block: batched vs sequential episodes per hour against "
                         "the local scripted server, utilisation, host ms per decision; ignjax.bench.llm)")
+    p.add_argument("--pieces", action="store_true",
+                   help="only where a decision step's time goes: microseconds per decision of each piece of the step "
+                        "(ignjax.bench.pieces); with --quick the EIG and random agents")
     args = p.parse_args(argv)
     # imported here, not at the top: the figures pull in jax, MuJoCo and the
     # simulator (about 5 s), which ``--help`` should not wait for
@@ -107,6 +116,11 @@ def main(argv=None) -> int:
         log(f"  wrote {res['scaling']['files']['png']}")
         print(json.dumps(res, sort_keys=True) if args.json else json.dumps(res, indent=2, sort_keys=True))
         return 0
+    if args.pieces:
+        es = load_benchmark(args.episodes or SHIPPED_BENCHMARK)
+        res["pieces"] = _pieces(es, make_world(es), ("random", "eig") if args.quick else AGENTS)
+        print(json.dumps(res, sort_keys=True) if args.json else json.dumps(res, indent=2, sort_keys=True))
+        return 0
     log("rays ...")
     res.update(bench_rays(args.quick))
     r = res["rays_per_s"]
@@ -130,6 +144,7 @@ def main(argv=None) -> int:
     log(f"  EIG rollout compile {res['compile_s']:.1f} s")
     log(f"what the machine allows a decision step (B = {LIMIT_BATCH}) ...")
     res["limit"] = bench_limit(es, world, agents, LIMIT_BATCH, res["steps_per_s"], args.quick)
+    res["pieces"] = _pieces(es, world, agents)
     res["scaling"] = _scaling(es, world)
     log("studies ...")
     res["studies"] = bench_studies(es, world, args.quick)
@@ -138,6 +153,15 @@ def main(argv=None) -> int:
     else:
         print(json.dumps(res, indent=2, sort_keys=True))
     return 0
+
+
+def _pieces(es, world, agents) -> dict:
+    """:func:`ignjax.bench.pieces.bench_pieces` at the limit's batch, with its progress lines."""
+    from ignjax.bench.limit import LIMIT_BATCH
+    from ignjax.bench.pieces import bench_pieces
+
+    log(f"where a decision step's time goes (one device's share of B = {LIMIT_BATCH}) ...")
+    return bench_pieces(es, world, agents, LIMIT_BATCH)
 
 
 def _scaling(es, world=None) -> dict:

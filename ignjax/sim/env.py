@@ -144,10 +144,7 @@ def step_batch(world: World, states: T.SimState, actions: T.Action, chunk: int |
     :func:`ignjax.sim.compact.masked_map`)."""
     with jax.named_scope("sim_step"):
         cfg = world.config
-        act, bad = jax.vmap(lambda a: sanitize_action(a, cfg.n_views))(actions)
-        live = ~states.done
-        is_move = (act.kind == T.MOVE) & live
-        is_ask = (act.kind == T.ASK) & live
+        act, bad, is_move, is_ask = step_kinds(world, states, actions)
         is_stop = act.kind == T.STOP
 
         # MOVE
@@ -163,7 +160,7 @@ def step_batch(world: World, states: T.SimState, actions: T.Action, chunk: int |
             answers=dataclasses.replace(a, hint_progress=progress, follow_up=follow),
         )
         # ASK
-        asked_state = masked_map(lambda x: ask(world, *x), is_ask, (states, act.question, act.candidate), states, chunk)
+        asked_state = ask_rows(world, states, act, is_ask, chunk)
         nxt = T.tree_select(is_move, moved_state, T.tree_select(is_ask, asked_state, states))
         n_step = states.step + 1
         stop_reason = jnp.where(is_stop, T.STOPPED, jnp.where(n_step >= cfg.max_steps, T.OUT_OF_STEPS, T.RUNNING))
@@ -172,6 +169,19 @@ def step_batch(world: World, states: T.SimState, actions: T.Action, chunk: int |
             done=stop_reason != T.RUNNING, stop_reason=stop_reason.astype(jnp.int32),
         )
         return T.tree_select(states.done, states, nxt)
+
+
+def step_kinds(world: World, states: T.SimState, actions: T.Action):
+    """The actions of a batch made valid (:func:`sanitize_action`) and which
+    unfinished rows MOVE and which ASK: (action, invalid (B,), is_move (B,), is_ask (B,))."""
+    act, bad = jax.vmap(lambda a: sanitize_action(a, world.config.n_views))(actions)
+    live = ~states.done
+    return act, bad, (act.kind == T.MOVE) & live, (act.kind == T.ASK) & live
+
+
+def ask_rows(world: World, states: T.SimState, act: T.Action, is_ask, chunk: int | None = None) -> T.SimState:
+    """The oracle's answers for the rows in ``is_ask`` (the others' states unchanged)."""
+    return masked_map(lambda x: ask(world, *x), is_ask, (states, act.question, act.candidate), states, chunk)
 
 
 def step(world: World, state: T.SimState, action: T.Action) -> T.SimState:

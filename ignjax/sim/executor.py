@@ -2,7 +2,8 @@
 depth, back-projection) -> the local controller's micro-steps with
 collision probes (the MOVE rules of :mod:`ignjax.sim.env`'s docstring).
 
-:func:`execute_moves` runs it for the moving rows of a batch;
+:func:`execute_moves` runs it for the moving rows of a batch (its two
+halves: :func:`move_waypoints`, then :func:`micro_steps`);
 :func:`execute_move` is the same on a batch of one.
 """
 
@@ -242,14 +243,32 @@ def execute_moves(world: World, states: T.SimState, direction, col, row, mask, c
     Returns:
         (pose (B, 3), moved (B,), min_distance (B,), blocked (B, 8), waypoint (B, 2)).
     """
+    wp = move_waypoints(world, states, direction, col, row, mask, chunk)
+    return micro_steps(world, states, wp, mask, chunk) + (wp,)
+
+
+def move_waypoints(world: World, states: T.SimState, direction, col, row, mask, chunk: int | None = None):
+    """The first half of :func:`execute_moves`: the waypoints (B, 2) of the
+    rows in ``mask`` (their depth rays in two passes, :func:`cell_depth_batch`);
+    the other rows' are their positions."""
+    s, pose0 = states.episode.scene, states.pose
+    depth = cell_depth_batch(world, s, pose0, direction, col, row, mask, chunk)
+    return masked_map(lambda a: pixel_waypoint(world, *a[:5], depth=a[5])[0], mask,
+                      (s, pose0, direction, col, row, depth), pose0[:, :2], chunk)
+
+
+def micro_steps(world: World, states: T.SimState, wp, mask, chunk: int | None = None):
+    """The second half of :func:`execute_moves`: the controller's micro-steps
+    towards the waypoints ``wp`` (B, 2) of the rows in ``mask``.
+
+    Returns:
+        (pose (B, 3), moved (B,), min_distance (B,), blocked (B, 8)).
+    """
     cfg = world.config
     ep = states.episode
     s = ep.scene
     pose0 = states.pose
     B = mask.shape[0]
-    depth = cell_depth_batch(world, s, pose0, direction, col, row, mask, chunk)
-    wp = masked_map(lambda a: pixel_waypoint(world, *a[:5], depth=a[5])[0], mask, (s, pose0, direction, col, row, depth),
-                    pose0[:, :2], chunk)
     yaw0 = pose0[:, 2]
     offsets = jnp.array(_OFFSETS, jnp.float32) * (math.pi / 4)
 
@@ -284,7 +303,7 @@ def execute_moves(world: World, states: T.SimState, direction, col, row, mask, c
     init = (jnp.int32(0), pose0, jnp.zeros(B, jnp.float32), states.min_distance, jnp.zeros((B, 8), bool), mask)
     _, pose, moved, dmin, blocked, _ = jax.lax.while_loop(cond, micro, init)
     pose = jnp.where(mask[:, None], pose.at[:, 2].set(G.wrap_angle(pose[:, 2])), pose)
-    return pose, moved, dmin, blocked, wp
+    return pose, moved, dmin, blocked
 
 
 def execute_move(world: World, state: T.SimState, direction, col, row):

@@ -199,6 +199,15 @@ def _shard_widths(n: int, copies: int, parts: int, chunk: int | None) -> tuple[i
     return widths
 
 
+def shard_layout(n: int, parts: int, copies: int = 1, chunk: int | None = None) -> tuple[int, tuple[int, int, int]]:
+    """How a rollout of ``n`` episodes (each run ``copies`` times) lays out
+    over ``parts`` devices: (episodes per device, padding included; the
+    vectorised widths its rows run at: the agent's chunk, the simulator's
+    chunk and the simulator's chunk in group mode)."""
+    widths = _shard_widths(n, copies, parts, chunk)
+    return _shard_rows(n, copies, parts, widths), widths
+
+
 _REPLICAS: dict = {}
 
 
@@ -223,8 +232,8 @@ def _sharded_args(fn, world, specs, agent, params, keys, chunk, parts: int, copi
     """The arguments of :func:`_run_sharded` for :func:`_sharded` (episodes
     padded to ``parts`` equal shards): (args, static keyword arguments, padded rows)."""
     n = specs.scene.shape[0]
-    widths = _shard_widths(n, copies, parts, chunk)
-    size = _shard_rows(n, copies, parts, widths) * parts
+    rows, widths = shard_layout(n, parts, copies, chunk)
+    size = rows * parts
     specs, keys = pad_batch(specs, keys, size)
     mesh = device_mesh(parts)
     return ((_replicated(world, mesh), specs, params, keys),
@@ -266,6 +275,19 @@ def _keys(key: jax.Array, n: int) -> jax.Array:
     return key if key.shape == (n,) else jax.random.split(key, n)
 
 
+def rollout_start(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.Array):
+    """The start of :func:`rollout_rows`: (state, observation, agent state,
+    privileged information or None, step keys (max_steps, B)), all with
+    leading axis B but the step keys."""
+    state = jax.vmap(lambda sp, k: E.reset(world, sp, k))(specs, keys)
+    obs = jax.vmap(lambda st: E.observe(world, st))(state)
+    split = jax.vmap(jax.random.split)(keys)
+    pstate = jax.vmap(agent.init)(params, obs, split[:, 1])
+    step_keys = jnp.swapaxes(jax.vmap(lambda k: jax.random.split(k, world.config.max_steps))(split[:, 0]), 0, 1)
+    priv0 = jax.vmap(lambda st: E.privileged_info(world, st))(state) if agent.privileged else None
+    return state, obs, pstate, priv0, step_keys
+
+
 def rollout_rows(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.Array, chunk: int | None = None,
                  groups: jax.Array | None = None, group_chunk: int | None = None, act_chunk: int | None = None):
     """Run a batch of episodes (leading axis B) with per-row agent parameters.
@@ -300,14 +322,8 @@ def rollout_rows(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.Ar
     Returns:
         (OutcomeRow, Trajectory, final SimState) with leading axis B.
     """
-    cfg = world.config
-    state = jax.vmap(lambda sp, k: E.reset(world, sp, k))(specs, keys)
-    obs = jax.vmap(lambda st: E.observe(world, st))(state)
-    split = jax.vmap(jax.random.split)(keys)
-    pstate = jax.vmap(agent.init)(params, obs, split[:, 1])
-    step_keys = jnp.swapaxes(jax.vmap(lambda k: jax.random.split(k, cfg.max_steps))(split[:, 0]), 0, 1)
+    state, obs, pstate, priv0, step_keys = rollout_start(world, specs, agent, params, keys)
     privileged = (lambda st: E.privileged_info(world, st)) if agent.privileged else None
-    priv0 = jax.vmap(privileged)(state) if privileged else None
     act = lambda x: agent.act(*x)  # noqa: E731
     act_chunk = act_chunk or even_chunk(keys.shape[0], chunk or chunk_size(keys.shape[0]))
 

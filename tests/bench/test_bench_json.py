@@ -7,7 +7,8 @@ CPU, so the command itself runs only in the optional ``slow`` tests
 (``pytest -m slow``). The default run checks the record's parts that the
 bench's library functions make in seconds: the probe-ray agreement
 (:func:`ignjax.bench.rays.bench_probe_rays`) and the decision-steps table
-(:func:`ignjax.bench.rollouts.bench_steps`, at the test benchmark's size).
+(:func:`ignjax.bench.rollouts.bench_steps`, at the test benchmark's size)
+and the pieces of a step (:func:`ignjax.bench.pieces.bench_pieces`, 16 episodes).
 """
 
 from __future__ import annotations
@@ -19,6 +20,8 @@ import sys
 
 import pytest
 
+from ignjax.agents import get_agent
+from ignjax.bench.pieces import PIECES, bench_pieces
 from ignjax.bench.rays import bench_probe_rays
 from ignjax.bench.rollouts import bench_steps
 
@@ -28,7 +31,7 @@ STUDY_KEYS = {"offline_wsr_1e6_x_500_s", "in_loop_vectors", "in_loop_episodes", 
               "in_loop_episodes_per_s"}
 TOP_KEYS = {"device", "quick", "n_rays", "ngeom", "rays_per_s", "ray_agreement", "ray_agreement_depth_march",
             "scene_compile_s", "speedup_vs_mjx", "speedup_vs_multiray", "probe_ray_agreement", "rollout_parts",
-            "steps_per_s", "compile_s", "studies", "limit"}
+            "steps_per_s", "compile_s", "studies", "limit", "pieces", "scaling"}
 SIZES = ("256", "1024", "4096")
 
 
@@ -75,10 +78,31 @@ def check_record(res: dict) -> None:
     for name, a in lim["agents"].items():
         assert _positive(a["fraction"]) and _positive(a["work"]["gather_world"]), (name, a)
     assert all(_positive(v) for v in lim["rates"].values()), lim["rates"]
+    check_pieces(res["pieces"], ("random", "eig"))
     s = res["studies"]
     assert set(s) == STUDY_KEYS
     assert s["in_loop_vectors"] == 16 and s["in_loop_episodes"] == 500  # --quick: K = 16
     assert all(_positive(v) for v in s.values()), s
+
+
+def check_pieces(block, agents):
+    assert set(block["agents"]) == set(agents) and block["rows"] >= 1
+    for name, a in block["agents"].items():
+        us = a["us_per_decision"]
+        privileged = get_agent(name).privileged
+        assert set(us) == set(PIECES) - ({"privileged"} if not privileged else set()) | {"sum", "whole"}, (name, us)
+        assert all(_positive(v) for k, v in us.items() if k != "step_other"), (name, us)  # step_other: a difference
+        assert math.isclose(us["sum"], sum(v for k, v in us.items() if k not in ("sum", "whole")))
+        # the host loop of separately compiled pieces takes the rollout's decisions
+        assert a["decisions"] == a["rollout_decisions"] > 0, (name, a)
+
+
+def test_pieces_follow_the_rollout(small_benchmark, small_world):
+    """The pieces, driven step by step from the host, take the same decisions
+    as the fused rollout of the same rows, and each has a time."""
+    block = bench_pieces(small_benchmark["set"], small_world, ("shortest_path",), 16, repeats=1)
+    assert block["rows"] == 8 and block["batch"] == 16  # one device's share of 16 over the session's 2 devices
+    check_pieces(block, ("shortest_path",))
 
 
 def test_probe_ray_agreement_figures():
