@@ -1,7 +1,8 @@
 """``--processes N``: start N copies of a command line on this machine.
 
-The launcher picks a free port on 127.0.0.1 for the coordinator, starts N
-copies of ``python -m <module> <arguments>`` with ``--coordinator``,
+The launcher reserves a port on 127.0.0.1 for the coordinator
+(:func:`reserved_port`, held for the whole run), starts N copies of
+``python -m <module> <arguments>`` with ``--coordinator``,
 ``--num-processes`` and ``--process-id`` set (and, unless
 ``IGNJAX_CPU_DEVICES`` is set, each with its share of the cores as CPU
 devices), and waits for them. The first process that exits non-zero ends
@@ -12,12 +13,14 @@ process's exit code, or 1 when a signal ended it). Nothing is left running.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import socket
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
 
 from ignjax.devices import ENV_VAR, available_cores
 from ignjax.devices.processes import local_cpu_devices
@@ -29,11 +32,31 @@ KILL_GRACE_S = 5.0
 """Seconds between SIGTERM and SIGKILL when the launcher stops the others."""
 
 
-def free_port(host: str = "127.0.0.1") -> int:
-    """A TCP port nothing listens on now (the OS's choice)."""
+@contextlib.contextmanager
+def reserved_port(host: str = "127.0.0.1") -> Iterator[int]:
+    """Hold a TCP port (the OS's choice) for the ``with`` block: yields its number.
+
+    The port is held by a socket bound to ``host`` with ``SO_REUSEPORT`` and
+    ``SO_REUSEADDR`` that never listens, so connections to the port are
+    refused until a server takes it. The OS gives the port to no one who
+    asks for port 0 while it is held, and a socket that sets neither option
+    gets ``EADDRINUSE``, so no other program can come by the port between
+    the choice and its use. The sockets that can bind it meanwhile are
+    ``SO_REUSEPORT`` sockets of the same user, such as the gRPC server of
+    JAX's coordination service (gRPC sets the option on Linux), and, while
+    nothing listens on it, sockets that set ``SO_REUSEADDR``, such as the
+    check process 0 makes that the coordinator's port is free
+    (:mod:`ignjax.devices.processes`). Without ``SO_REUSEADDR`` here that
+    check would fail; with it, a program that binds this very port number
+    with ``SO_REUSEADDR`` before the coordinator listens could take it, but
+    such a program must have been given the number, since no port-0 bind
+    returns it.
+    """
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEPORT, 1)
         s.bind((host, 0))
-        return s.getsockname()[1]
+        yield s.getsockname()[1]
 
 
 def strip_processes(argv: list[str]) -> list[str]:
@@ -83,6 +106,10 @@ def launch(module: str, argv: list[str], n: int, *, quiet_flag: str | None = "--
         n: processes (>= 2).
         quiet_flag: added to the arguments of every process but 0 (one progress display).
 
+    The coordinator's port stays reserved (:func:`reserved_port`) until the
+    processes are done, so no other program can take it before process 0's
+    coordinator binds it.
+
     Returns:
         0 when every process exited with 0; else the exit code of the first
         process that failed (1 when a signal ended it).
@@ -90,7 +117,12 @@ def launch(module: str, argv: list[str], n: int, *, quiet_flag: str | None = "--
     if os.environ.get(LAUNCHED_ENV):
         print("error: --processes: this process was itself started by a launcher", file=sys.stderr)
         return 2
-    port = free_port()
+    with reserved_port() as port:
+        return _run(module, argv, n, port, quiet_flag, grace, poll_s)
+
+
+def _run(module: str, argv: list[str], n: int, port: int, quiet_flag: str | None, grace: float, poll_s: float) -> int:
+    """:func:`launch` with the coordinator's port held by the caller."""
     base = strip_processes(list(argv))
     env = dict(os.environ, **{LAUNCHED_ENV: "1"})
     if not env.get(ENV_VAR, "").strip():
@@ -128,4 +160,4 @@ def launch(module: str, argv: list[str], n: int, *, quiet_flag: str | None = "--
             signal.signal(s, h)
 
 
-__all__ = ["KILL_GRACE_S", "LAUNCHED_ENV", "free_port", "launch", "strip_processes"]
+__all__ = ["KILL_GRACE_S", "LAUNCHED_ENV", "launch", "reserved_port", "strip_processes"]

@@ -150,7 +150,7 @@ def add_arguments(parser) -> None:
     g = parser.add_argument_group(
         "processes (several processes or hosts split the episodes; process 0 writes the outputs)")
     g.add_argument("--processes", type=int, default=None, metavar="N",
-                   help="start N local processes on this machine (coordinator on 127.0.0.1, a free port); "
+                   help="start N local processes on this machine (coordinator on 127.0.0.1, on a port the launcher holds for the run); "
                         "each gets IGNJAX_CPU_DEVICES = cores / N unless set")
     g.add_argument("--coordinator", default=None, metavar="HOST:PORT",
                    help=f"process 0's address, where it runs the coordinator (or ${ENV_COORDINATOR})")

@@ -34,7 +34,9 @@ on it and the benchmarks can be exercised end to end without a GPU:
   body was received) — deterministic for the same request sequence, while a
   retried request draws anew. :meth:`ScriptedServer.stats` reports requests
   received, most served at once, queue high-water mark, faults by kind and
-  responses by status.
+  responses by status; :attr:`ScriptedServer.arrivals` gives the time each
+  recent request arrived, on the server's own ``time.monotonic`` clock (the
+  wait a client let pass between two requests, as the server saw it).
 * **Faults** (``--faults SPEC``), grammar::
 
       SPEC := ITEM ("," ITEM)*
@@ -56,8 +58,11 @@ on it and the benchmarks can be exercised end to end without a GPU:
   ``finish_reason`` ``"length"``.
 
 Use it as ``with ScriptedServer(latency=0.0, faults="500@1") as srv:
-srv.base_url`` (its own thread and event loop, port 0 = a free port), or
-from a shell: ``python -m ignjax.agents.llm.serve --port 8000``.
+srv.base_url`` (its own thread and event loop; port 0, the default, lets
+the OS choose a free port as the server binds it, and ``srv.port`` is the
+port it got), or from a shell: ``python -m ignjax.agents.llm.serve --port
+0``, which prints ``... listening on http://127.0.0.1:PORT/v1 ...`` with the
+bound port once it serves.
 """
 
 from __future__ import annotations
@@ -382,8 +387,10 @@ class ScriptedServer:
         reject_response_format: answer 400 to any ``response_format``.
         retry_after: ``Retry-After`` seconds sent with a 429 fault.
         slow_s: how long a ``slow`` fault sleeps.
-        history: how many recent request bodies :attr:`requests` keeps.
-        host, port: where to listen (port 0: a free port).
+        history: how many recent request bodies :attr:`requests` (and
+            arrival times, :attr:`arrivals`) it keeps.
+        host, port: where to listen (port 0: a free port, chosen as the
+            server binds it; :attr:`port` is then the bound port).
     """
 
     def __init__(self, *, model: str = DEFAULT_MODEL, latency: float = 0.0, jitter: float = 0.0,
@@ -402,6 +409,7 @@ class ScriptedServer:
         self.retry_after, self.slow_s = float(retry_after), float(slow_s)
         self.host, self.port = host, int(port)
         self._history = collections.deque(maxlen=max(1, history))
+        self._arrivals = collections.deque(maxlen=max(1, history))
         self._lock = threading.Lock()
         self._loop: asyncio.AbstractEventLoop | None = None
         self._thread: threading.Thread | None = None
@@ -423,6 +431,7 @@ class ScriptedServer:
             self._last_headers: dict = {}
             self._last_images: list[tuple[str, bytes]] = []
             self._history.clear()
+            self._arrivals.clear()
 
     def stats(self) -> dict:
         """``requests`` received, ``max_concurrent`` served at once,
@@ -458,6 +467,14 @@ class ScriptedServer:
             return list(self._history)
 
     @property
+    def arrivals(self) -> list[float]:
+        """``time.monotonic()`` on the server when each of the last
+        ``history`` chat requests arrived (every one received, rejected or
+        not), oldest first."""
+        with self._lock:
+            return list(self._arrivals)
+
+    @property
     def base_url(self) -> str:
         return f"http://{self.host}:{self.port}/v1"
 
@@ -483,9 +500,11 @@ class ScriptedServer:
             self._statuses[status] += 1
 
     async def _chat(self, request: web.Request) -> web.StreamResponse:
+        arrived = time.monotonic()
         raw = await request.read()
         key = hashlib.sha256(raw).hexdigest()
         with self._lock:
+            self._arrivals.append(arrived)
             self._received += 1
             n = self._received
             self._attempts[key] += 1
@@ -647,7 +666,8 @@ def main(argv: list[str] | None = None) -> int:
                                  description="Scripted OpenAI-compatible chat server. A TEST DOUBLE: replies are "
                                              "computed from the request text by a script, not by a model.")
     ap.add_argument("--host", default="127.0.0.1")
-    ap.add_argument("--port", type=int, default=8000, help="0: a free port (printed)")
+    ap.add_argument("--port", type=int, default=8000,
+                    help="0: a free port, chosen as the server binds it (the ready line names it)")
     ap.add_argument("--model", default=DEFAULT_MODEL)
     ap.add_argument("--latency", type=float, default=0.0, help="seconds per served request")
     ap.add_argument("--jitter", type=float, default=0.0, help="relative latency jitter in [0, 1]")

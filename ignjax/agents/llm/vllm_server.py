@@ -4,8 +4,9 @@ tests and load measurements.
 :func:`start_vllm_server` (a context manager) starts
 ``python -m vllm.entrypoints.openai.api_server`` from the environment that
 ``.ci/prepare-vllm`` builds under ``${IGNJAX_VLLM_HOME:-~/.cache/ignjax/vllm}``
-(``venv/``, ``model/``, ``status``; :func:`vllm_home`), on a free loopback
-port, in its own process group, waits until ``/v1/models`` answers, yields a
+(``venv/``, ``model/``, ``status``; :func:`vllm_home`), on a loopback port
+the server chooses itself (below), in its own process group, waits until
+``/v1/models`` answers, yields a
 :class:`VllmServer` (``base_url`` = ``http://127.0.0.1:PORT/v1``, ``model`` =
 ``"tiny-vl"``, ``log_path``) and stops the server's whole process group at
 the end. :func:`environment_problem` says why the environment is absent (not
@@ -35,6 +36,28 @@ Server settings (vLLM 0.32.0) and why:
   depending on the machine's load, instead of 30 s more; same outputs);
 - ``--seed 0``; ``VLLM_CPU_KVCACHE_SPACE=1`` (GiB); offline Hugging Face.
 
+The port. The server is started with ``--port 0``: it binds 127.0.0.1
+port 0 itself, so the OS gives it a free port in the same call that takes
+it, and no other program can take that port first (choosing a free port
+here, closing it and passing its number would leave a gap in which another
+program could bind it). vLLM 0.32 binds its socket before it builds the
+engine, listens on it only once the engine is ready, and never says which
+port it got (its log says "Starting vLLM server on http://127.0.0.1:0", the
+number it was given, and uvicorn, handed the bound socket, logs no
+address), so the port is read from the kernel: :func:`listening_ports`
+lists the TCP ports on which the server's process (the API server, the
+group's leader) holds a listening socket, matching the socket inodes of
+``/proc/PID/fd`` with the LISTEN entries of ``/proc/PID/net/tcp`` and
+``tcp6``; the server is ready when one of them answers ``/v1/models`` with
+the served model. Only the leader's sockets count: vLLM's worker process
+listens on a dozen ports of its own. Other ways were ruled out: this entry
+point's socket sets ``SO_REUSEADDR`` but not ``SO_REUSEPORT`` (``vllm
+serve`` sets it only with several API servers), so a port cannot be held
+for it with ``SO_REUSEPORT`` as :func:`ignjax.devices.launch.reserved_port`
+does for JAX's coordinator; it takes no socket or file descriptor from its
+parent; and ``--uds`` (a Unix socket) would need every client to speak HTTP
+over a Unix socket.
+
 It uses about 3.1-3.3 GB of RAM (API server 0.7, engine core 0.7, worker 1.8-1.9).
 ``IGNJAX_VLLM_START_TIMEOUT`` (seconds, default 180) bounds the start unless
 ``start_timeout_s`` is given.
@@ -47,7 +70,6 @@ import json
 import os
 import shutil
 import signal
-import socket
 import subprocess
 import tempfile
 import time
@@ -122,10 +144,46 @@ class VllmServer:
     max_num_seqs: int = MAX_NUM_SEQS
 
 
-def _free_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
+TCP_LISTEN = "0A"
+"""The state of a listening socket in ``/proc/net/tcp`` (``TCP_LISTEN`` = 10)."""
+
+
+def _socket_inodes(pid: int) -> set[str]:
+    """The inodes of the sockets among process ``pid``'s open files."""
+    fd_dir = Path(f"/proc/{pid}/fd")
+    try:
+        names = os.listdir(fd_dir)
+    except OSError:  # no such process, or not Linux
+        return set()
+    inodes = set()
+    for name in names:
+        try:
+            target = os.readlink(fd_dir / name)
+        except OSError:  # closed meanwhile
+            continue
+        if target.startswith("socket:[") and target.endswith("]"):
+            inodes.add(target[len("socket:["):-1])
+    return inodes
+
+
+def listening_ports(pid: int) -> set[int]:
+    """The TCP ports (IPv4 and IPv6) on which process ``pid`` holds a
+    listening socket, read from ``/proc``; empty when the process is gone
+    or ``/proc`` does not tell (not Linux). A socket that is bound but not
+    yet listening is not counted."""
+    inodes = _socket_inodes(pid)
+    ports = set()
+    for table in ("tcp", "tcp6"):
+        try:
+            lines = Path(f"/proc/{pid}/net/{table}").read_text(encoding="ascii").splitlines()[1:]
+        except OSError:
+            continue
+        for line in lines:
+            # sl local_address rem_address st tx_queue:rx_queue tr:tm->when retrnsmt uid timeout inode ...
+            fields = line.split()
+            if len(fields) > 9 and fields[3] == TCP_LISTEN and fields[9] in inodes:
+                ports.add(int(fields[1].rsplit(":", 1)[1], 16))
+    return ports
 
 
 def _tail(path: Path, lines: int = 60) -> str:
@@ -136,8 +194,9 @@ def _tail(path: Path, lines: int = 60) -> str:
     return "\n".join(text.splitlines()[-lines:])
 
 
-def server_command(python: Path, model_dir: Path, port: int, *, max_num_seqs: int = MAX_NUM_SEQS) -> list[str]:
-    """The server's command line (settings and reasons: module docstring)."""
+def server_command(python: Path, model_dir: Path, port: int = 0, *, max_num_seqs: int = MAX_NUM_SEQS) -> list[str]:
+    """The server's command line (settings and reasons: module docstring);
+    ``port`` 0 lets the server take a free port itself."""
     return [
         str(python),
         "-m",
@@ -212,6 +271,27 @@ def _models_answer(base_url: str) -> bool:
         return False
 
 
+def _serving_url(proc: subprocess.Popen, log: Path, timeout: float) -> str:
+    """The base URL of the server ``proc`` started with ``--port 0``, once
+    ``/v1/models`` answers on a port its process listens on (module
+    docstring: the port)."""
+    deadline = time.monotonic() + timeout
+    while True:
+        ports = listening_ports(proc.pid)
+        for port in sorted(ports):
+            url = f"http://127.0.0.1:{port}/v1"
+            if _models_answer(url):
+                return url
+        if proc.poll() is not None:
+            raise VllmServerError(f"vLLM server exited with {proc.returncode} while starting; log {log}:\n{_tail(log)}")
+        if time.monotonic() > deadline:
+            listening = ", ".join(map(str, sorted(ports))) or "none"
+            where = f"on any port it listens on ({listening})"
+            raise VllmServerError(f"vLLM server did not answer /v1/models {where} within {timeout:.0f} s; "
+                                  f"log {log}:\n{_tail(log)}")
+        time.sleep(0.5)
+
+
 @contextlib.contextmanager
 def start_vllm_server(home: str | os.PathLike | None = None, *, max_num_seqs: int = MAX_NUM_SEQS,
                       start_timeout_s: float | None = None,
@@ -246,12 +326,10 @@ def start_vllm_server(home: str | os.PathLike | None = None, *, max_num_seqs: in
     workdir = Path(tempfile.mkdtemp(prefix="ignjax-vllm-"))
     log = Path(log_path) if log_path is not None else workdir / "server.log"
     log.parent.mkdir(parents=True, exist_ok=True)
-    port = _free_port()
-    base_url = f"http://127.0.0.1:{port}/v1"
     keep_workdir = False
     with open(log, "wb") as fh:
         proc = subprocess.Popen(
-            server_command(home / "venv" / "bin" / "python", home / "model", port, max_num_seqs=max_num_seqs),
+            server_command(home / "venv" / "bin" / "python", home / "model", 0, max_num_seqs=max_num_seqs),
             cwd=workdir,
             env=server_env(home),
             stdin=subprocess.DEVNULL,
@@ -260,17 +338,11 @@ def start_vllm_server(home: str | os.PathLike | None = None, *, max_num_seqs: in
             start_new_session=True,  # its own process group, stopped as one
         )
     try:
-        deadline = time.monotonic() + timeout
-        while not _models_answer(base_url):
-            if proc.poll() is not None:
-                keep_workdir = True
-                raise VllmServerError(f"vLLM server exited with {proc.returncode} while starting; "
-                                      f"log {log}:\n{_tail(log)}")
-            if time.monotonic() > deadline:
-                keep_workdir = True
-                raise VllmServerError(f"vLLM server did not answer {base_url}/models within {timeout:.0f} s; "
-                                      f"log {log}:\n{_tail(log)}")
-            time.sleep(0.5)
+        try:
+            base_url = _serving_url(proc, log, timeout)
+        except VllmServerError:
+            keep_workdir = True
+            raise
         yield VllmServer(
             base_url=base_url,
             model=SERVED_MODEL,
@@ -288,5 +360,5 @@ def start_vllm_server(home: str | os.PathLike | None = None, *, max_num_seqs: in
 
 
 __all__ = ["DEFAULT_START_TIMEOUT_S", "MAX_IMAGES", "MAX_MODEL_LEN", "MAX_NUM_SEQS", "SERVED_MODEL", "VllmServer",
-           "VllmServerError", "environment_problem", "server_command", "server_env", "start_timeout_from_env",
-           "start_vllm_server", "vllm_home"]
+           "VllmServerError", "environment_problem", "listening_ports", "server_command", "server_env",
+           "start_timeout_from_env", "start_vllm_server", "vllm_home"]

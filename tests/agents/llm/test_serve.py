@@ -8,10 +8,11 @@ import base64
 import json
 import os
 import random
+import re
+import select
 import socket
 import subprocess
 import sys
-import time
 import urllib.error
 import urllib.request
 from concurrent.futures import ThreadPoolExecutor
@@ -21,6 +22,7 @@ import pytest
 
 from ignjax.agents.llm.parse import validate
 from ignjax.agents.llm.serve import DEFAULT_MODEL, FaultSpec, schema_instance
+from ignjax.agents.llm.vllm_server import listening_ports
 from ignjax.errors import ConfigError
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -201,30 +203,101 @@ def test_fault_responses(scripted_server):
     assert srv.stats()["faults"] == {"429": 1, "malformed": 1, "truncated": 1, "503": 1, "drop": 1}
 
 
-def test_command_line_server_answers_models():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
+READY = re.compile(r"listening on http://127\.0\.0\.1:(\d+)/v1 ")
+
+
+def start_cli(*args: str) -> subprocess.Popen:
+    """The command-line server started with ``--port 0`` and ``args``."""
     env = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
-    proc = subprocess.Popen([sys.executable, "-m", "ignjax.agents.llm.serve", "--port", str(port), "--model", "cli-m",
-                             "--faults", "500@1"], cwd=ROOT, env=env, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
-    try:
-        deadline, reply = time.monotonic() + 60, None
-        while time.monotonic() < deadline and reply is None:
-            assert proc.poll() is None, proc.communicate()[1]
-            try:
-                with urllib.request.urlopen(f"http://127.0.0.1:{port}/v1/models", timeout=2) as r:
-                    reply = json.loads(r.read())
-            except (urllib.error.URLError, ConnectionError):
-                time.sleep(0.2)
-        assert reply is not None and reply["data"][0]["id"] == "cli-m"
-    finally:
-        proc.terminate()
+    return subprocess.Popen([sys.executable, "-m", "ignjax.agents.llm.serve", "--port", "0", *args], cwd=ROOT, env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def ready_line(proc: subprocess.Popen, wait_s: float = 60) -> tuple[int, str]:
+    """The server's ready line (its first line on stdout), read as soon as it is printed, and the port it names."""
+    readable, _, _ = select.select([proc.stdout], [], [], wait_s)
+    line = proc.stdout.readline() if readable else ""
+    m = READY.search(line)
+    if m is None:
+        proc.kill()
         out, err = proc.communicate(timeout=30)
-    assert proc.returncode == 0, err
-    assert f"listening on http://127.0.0.1:{port}/v1" in out and "not a model" in out
-    assert "Traceback" not in err and "RuntimeWarning" not in err
+        pytest.fail(f"no ready line from the server (stdout {line + out!r}); stderr:\n{err[-2000:]}")
+    return int(m.group(1)), line
+
+
+def stop_cli(proc: subprocess.Popen) -> tuple[int, str, str]:
+    """Stop the server with SIGTERM (if it still runs): its exit code, stdout and stderr."""
+    if proc.poll() is None:
+        proc.terminate()
+    out, err = proc.communicate(timeout=30)
+    return proc.returncode, out, err
+
+
+def assert_clean_exit(code: int, out: str, err: str) -> None:
+    assert code == 0, err
+    assert "Traceback" not in err and "RuntimeWarning" not in err and "scripted server stopped" in err
+
+
+def models(port: int) -> list[str]:
+    with urllib.request.urlopen(f"http://127.0.0.1:{port}/v1/models", timeout=10) as r:
+        return [m["id"] for m in json.loads(r.read())["data"]]
+
+
+def test_command_line_server_answers_models():
+    """``--port 0``: the server binds a port of its own choosing and its ready line names it; that is the one
+    port its process listens on, and it answers there."""
+    proc = start_cli("--model", "cli-m", "--faults", "500@1")
+    try:
+        port, line = ready_line(proc)
+        listening, answer = listening_ports(proc.pid), models(port)
+    finally:
+        code, out, err = stop_cli(proc)
+    assert port > 0 and listening == {port} and answer == ["cli-m"]
+    assert "not a model" in line and "'cli-m'" in line
+    assert_clean_exit(code, out, err)
+
+
+def test_servers_started_at_once_get_ports_of_their_own(scripted_server):
+    """Two in-process servers and two command-line servers, all on port 0 and started together, each bind a
+    different port and each answers there with its own model."""
+    procs = [start_cli("--model", f"cli-{i}") for i in range(2)]
+    try:
+        a, b = scripted_server(model="in-0"), scripted_server(model="in-1")
+        ports = {"in-0": a.port, "in-1": b.port, "cli-0": ready_line(procs[0])[0],
+                 "cli-1": ready_line(procs[1])[0]}
+        answers = {model: models(port) for model, port in ports.items()}
+    finally:
+        exits = [stop_cli(proc) for proc in procs]
+    assert len(set(ports.values())) == 4 and min(ports.values()) > 0, ports
+    assert a.base_url == f"http://127.0.0.1:{a.port}/v1"
+    assert answers == {model: [model] for model in ports}
+    for e in exits:
+        assert_clean_exit(*e)
+
+
+def test_listening_ports_are_read_from_proc(scripted_server):
+    """:func:`listening_ports` (how the vLLM server's port is found): the listening sockets a process holds,
+    IPv4 and IPv6, not one that is only bound or already closed, and nothing for a process that is gone."""
+    srv = scripted_server()
+    with socket.socket() as listening, socket.socket() as bound:
+        listening.bind(("127.0.0.1", 0))
+        listening.listen()
+        bound.bind(("127.0.0.1", 0))
+        lport, bport = listening.getsockname()[1], bound.getsockname()[1]
+        ports = listening_ports(os.getpid())
+    assert {srv.port, lport} <= ports and bport not in ports
+    assert lport not in listening_ports(os.getpid()) and srv.port in listening_ports(os.getpid())
+    with socket.socket(socket.AF_INET6) as six:
+        try:
+            six.bind(("::1", 0))
+        except OSError:  # no IPv6 loopback on this machine
+            pass
+        else:
+            six.listen()
+            assert six.getsockname()[1] in listening_ports(os.getpid())
+    gone = subprocess.Popen([sys.executable, "-c", "pass"])
+    gone.wait(timeout=60)
+    assert listening_ports(gone.pid) == set()
 
 
 def test_command_line_rejects_a_bad_fault_spec():
