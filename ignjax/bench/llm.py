@@ -4,8 +4,8 @@
 Against the local scripted server (:class:`~ignjax.agents.llm.serve.ScriptedServer`,
 a test double: real HTTP on 127.0.0.1, replies scripted from the request
 text) with ``latency_s`` (+-25% jitter) and ``concurrency`` requests served
-at once, the ``vlm`` agent reads 8 views at 128 px (its Planner panel,
-JPEG). The scripted policy moves (a direction and cell chosen from the
+at once, the ``vlm`` agent reads 8 views at 128 px (``size``; its Planner
+panel, JPEG). The scripted policy moves (a direction and cell chosen from the
 request's hash) until the prompt says turn ``DECISIONS``, then stops, so
 every episode is ``DECISIONS`` decisions long.
 
@@ -32,13 +32,15 @@ pieces happens before the first request and is not counted in it, but is in
 the wall times). ``host_ms_per_decision``: the batched loop against a
 zero-latency server (observation, rendering, composition, encoding,
 request, parse, step), wall time per decision of the batched run's
-episodes and batch. A zero-latency warm-up run of the batched
-run's own episodes and batch comes first, so both loops' programs are
+episodes and batch (``wall_s["host"]`` over ``decisions["host"]``;
+``decisions`` counts each run's decision steps, ``wall_s`` times each
+run). A zero-latency warm-up run of the batched run's own episodes and
+batch comes first, so both loops' programs are
 compiled and the render contexts of the batched run's scenes made
 (:class:`~ignjax.sim.views.contexts.SceneContexts` keeps them) before
 anything is timed.
 ``limited_by`` names what bounds the batched figure: the server's
-concurrency x latency, or the host (rendering and stepping) when its
+concurrency / latency, or the host (rendering and stepping) when its
 decisions per second stay below what the server could answer.
 
 ``vllm``: the same loop (the ``vlm`` agent, the same views) against a real
@@ -70,6 +72,7 @@ reason}`` (its log's tail on stderr).
 from __future__ import annotations
 
 import contextlib
+import math
 import re
 import time
 from concurrent.futures import ThreadPoolExecutor, wait
@@ -130,14 +133,16 @@ def _shared(es, sim, views):
         renderer.close()
 
 
-def bench_llm(es, quick: bool, latency: float = 4.0, concurrency: int = 64) -> dict:
-    """The ``llm`` block (module docstring)."""
+def bench_llm(es, quick: bool, latency: float = 4.0, concurrency: int = 64, size: int = 128,
+              vllm: bool = True) -> dict:
+    """The ``llm`` block (module docstring): views of ``size`` px; ``vllm=False`` leaves out the ``vllm``
+    figures (``{"skipped": ...}``)."""
     from ignjax.agents.llm.serve import ScriptedServer
     from ignjax.sim.types import SimConfig
     from ignjax.sim.views import ViewConfig
 
     sim = SimConfig(max_steps=DECISIONS + 2)
-    views = ViewConfig(size=128, workers=0)
+    views = ViewConfig(size=size, workers=0)
     n_batched = concurrency * (2 if quick else 4)
     n_seq = 1 if quick else 3
     batched_es = es.subset(range(min(n_batched, len(es))))
@@ -151,27 +156,42 @@ def bench_llm(es, quick: bool, latency: float = 4.0, concurrency: int = 64) -> d
         with ScriptedServer(latency=0.0, concurrency=concurrency, policy=_policy) as srv:
             _run(batched_es, srv, in_flight, concurrency, views, sim, None, shared)
             _run(es.subset(range(1)), srv, 1, 1, views, sim, None, shared)  # the sequential loop's programs too
-            res, wall = _run(batched_es, srv, in_flight, concurrency, views, sim, None, shared)
-        out["host_ms_per_decision"] = 1000.0 * wall / max(1, res.stats["decisions"])
-        log(f"  host {out['host_ms_per_decision']:.1f} ms a decision ({res.stats['decisions']} decisions, zero latency)")
+            res_h, wall_h = _run(batched_es, srv, in_flight, concurrency, views, sim, None, shared)
+        log(f"  host {1000.0 * wall_h / max(1, res_h.stats['decisions']):.1f} ms a decision "
+            f"({res_h.stats['decisions']} decisions, zero latency)")
         with ScriptedServer(latency=latency, jitter=0.25, concurrency=concurrency, policy=_policy) as srv:
             res_b, wall_b = _run(batched_es, srv, in_flight, concurrency, views, sim, None, shared)
-            _, wall_s = _run(es.subset(range(n_seq)), srv, 1, 1, views, sim, None, shared)
-    eph_b = 3600.0 * len(batched_es) / wall_b
-    eph_s = 3600.0 * n_seq / wall_s
-    out["episodes_per_hour"] = {"batched": eph_b, "sequential": eph_s}
-    out["speedup_vs_sequential"] = eph_b / eph_s
+            res_s, wall_s = _run(es.subset(range(n_seq)), srv, 1, 1, views, sim, None, shared)
+    out["wall_s"] = {"host": wall_h, "batched": wall_b, "sequential": wall_s}
+    out["decisions"] = {k: int(r.stats["decisions"]) for k, r in (("host", res_h), ("batched", res_b),
+                                                                  ("sequential", res_s))}
+    out.update(scripted_figures(out["episodes"], out["wall_s"], out["decisions"], concurrency, latency))
     out["utilisation"] = res_b.stats["utilisation"]
-    out["wall_s"] = {"batched": wall_b, "sequential": wall_s}
     out["max_in_flight"] = res_b.stats["max_in_flight"]
-    server_rate = concurrency / latency
-    host_rate = 1000.0 / out["host_ms_per_decision"]
-    out["limited_by"] = "server" if host_rate >= server_rate else "host"
-    log(f"  batched {eph_b:.0f} episodes/h, sequential {eph_s:.0f}: {out['speedup_vs_sequential']:.1f}x; "
-        f"utilisation {out['utilisation']:.2f}; host {host_rate:.1f} decisions/s vs server {server_rate:.1f}/s "
+    eph = out["episodes_per_hour"]
+    log(f"  batched {eph['batched']:.0f} episodes/h, sequential {eph['sequential']:.0f}: "
+        f"{out['speedup_vs_sequential']:.1f}x; utilisation {out['utilisation']:.2f}; host "
+        f"{1000.0 / out['host_ms_per_decision']:.1f} decisions/s vs server {_server_rate(concurrency, latency):.1f}/s "
         f"-> limited by the {out['limited_by']}")
-    out["vllm"] = bench_vllm(es, quick, views)
+    out["vllm"] = bench_vllm(es, quick, views) if vllm else {"skipped": "not requested"}
     return out
+
+
+def scripted_figures(episodes: dict, wall_s: dict, decisions: dict, concurrency: int, latency: float) -> dict:
+    """The figures the scripted-server runs derive (module docstring) from their episodes, wall times and
+    decisions (``host``: the zero-latency run): episodes per hour of ``batched`` and ``sequential`` and their
+    ratio, host milliseconds per decision, and what limits the batched figure: the host when its decisions per
+    second stay below what the server answers (``concurrency / latency``), else the server."""
+    eph = {k: 3600.0 * episodes[k] / wall_s[k] for k in ("batched", "sequential")}
+    host_ms = 1000.0 * wall_s["host"] / max(1, decisions["host"])
+    return {"episodes_per_hour": eph, "speedup_vs_sequential": eph["batched"] / eph["sequential"],
+            "host_ms_per_decision": host_ms,
+            "limited_by": "server" if 1000.0 / host_ms >= _server_rate(concurrency, latency) else "host"}
+
+
+def _server_rate(concurrency: int, latency: float) -> float:
+    """Decisions per second the scripted server answers at most: ``concurrency / latency``."""
+    return concurrency / latency if latency > 0 else math.inf
 
 
 def bench_vllm(es, quick: bool, views) -> dict:
@@ -242,10 +262,9 @@ def bench_vllm(es, quick: bool, views) -> dict:
     out["requests"] = {k: int(a["requests"].sum()) for k, a in acc.items()}
     out["invalid_replies"] = {k: int(a["invalid_replies"].sum()) for k, a in acc.items()}
     out["failed_episodes"] = {k: sum(bool(f) for f in a["failure"]) for k, a in acc.items()}
-    out["request_s"] = {k: float(a["model_latency_s"].sum()) / max(1, out["requests"][k]) for k, a in acc.items()}
     out["wall_s"] = {k: float(r.stats["wall_s"]) for k, r in runs.items()}
-    out["decisions_per_s"] = {k: out["decisions"][k] / out["wall_s"][k] for k in runs}
-    out["speedup"] = out["decisions_per_s"]["batched"] / out["decisions_per_s"]["sequential"]
+    out.update(vllm_figures(out["decisions"], out["requests"],
+                            {k: float(a["model_latency_s"].sum()) for k, a in acc.items()}, out["wall_s"]))
     out["utilisation"] = res_b.stats["utilisation"]
     d, w = out["decisions_per_s"], out["wall_s"]
     log(f"  vLLM: batched {d['batched']:.2f} decisions/s ({out['decisions']['batched']} in {w['batched']:.1f} s), "
@@ -256,4 +275,13 @@ def bench_vllm(es, quick: bool, views) -> dict:
     return out
 
 
-__all__ = ["bench_llm", "bench_vllm"]
+def vllm_figures(decisions: dict, requests: dict, request_seconds: dict, wall_s: dict) -> dict:
+    """The ``vllm`` figures derived from each run's (``batched``, ``sequential``) decisions, requests, seconds
+    its requests waited on the server in all, and wall time: ``request_s`` (mean seconds a request waited; 0
+    without requests), ``decisions_per_s`` and ``speedup`` (batched over sequential decisions per second)."""
+    rate = {k: decisions[k] / wall_s[k] for k in ("batched", "sequential")}
+    return {"request_s": {k: request_seconds[k] / max(1, requests[k]) for k in rate}, "decisions_per_s": rate,
+            "speedup": rate["batched"] / rate["sequential"]}
+
+
+__all__ = ["bench_llm", "bench_vllm", "scripted_figures", "vllm_figures"]

@@ -14,10 +14,36 @@ default)`` row for row (tested), whatever the chunk size.
 
 from __future__ import annotations
 
+import contextlib
+
 import jax
 import jax.numpy as jnp
 
 CHUNKS = 8  # default chunk: 1/CHUNKS of the batch (at most that fraction of a batch is padding)
+
+ONE_PASS = False
+"""Read while a program is traced: true gives the batched ray casts and
+probes their one-pass forms (every free-space ray, sight line and depth ray
+marched to its end; all seven alternative headings of a blocked row probed)
+instead of their passes (:func:`ignjax.sim.observation.sight_batch`,
+:func:`ignjax.sim.executor.cell_depth_batch`,
+:func:`ignjax.sim.executor.first_free_alternative`): the reference the tests
+compare the rollouts with. Set it through :func:`one_pass`."""
+
+
+@contextlib.contextmanager
+def one_pass():
+    """Programs traced inside take the one-pass forms (:data:`ONE_PASS`).
+    JAX's caches are cleared on entry and on exit, so a program compiled in
+    one form is never reused in the other."""
+    global ONE_PASS
+    jax.clear_caches()
+    ONE_PASS = True
+    try:
+        yield
+    finally:
+        ONE_PASS = False
+        jax.clear_caches()
 
 
 def chunk_size(n_rows: int, chunks: int = CHUNKS) -> int:

@@ -14,6 +14,7 @@ import math
 import jax
 import jax.numpy as jnp
 
+from ignjax.sim import compact
 from ignjax.sim import geometry as G
 from ignjax.sim import types as T
 from ignjax.sim.compact import chunk_size, masked_map
@@ -92,10 +93,14 @@ def cell_depth_batch(world: World, s, pose, direction, col, row, mask, chunk: in
     the rays those leave open take the rest of the traversal and its exact
     rounds, compacted (:func:`ignjax.sim.compact.masked_map`, chunks of a
     quarter of ``chunk``), instead of every ray taking all of them. Each step
-    is the same computation, so the depths are :func:`cell_depth`'s."""
+    is the same computation, so the depths are :func:`cell_depth`'s (one
+    march per ray under :func:`ignjax.sim.compact.one_pass`)."""
     cfg = world.config
     B = mask.shape[0]
     args = (s, pose, direction, col, row)
+    if compact.ONE_PASS:
+        return masked_map(lambda a: cell_depth(world, *a), mask, args, (jnp.zeros(B, jnp.float32), jnp.zeros(B, bool)),
+                          chunk)
 
     def begin(a):
         (t_wc, u, max_dist, norm), statics = _depth_ray(world, *a[1:])
@@ -198,6 +203,8 @@ def first_free_alternative(world: World, s, xy, h0, need, chunk: int | None = No
         first free alternative (0 where none is free or the row is not in
         ``need``) and whether its full micro-step is navigable.
     """
+    if compact.ONE_PASS:
+        return _every_alternative(world, s, xy, h0, need, chunk)
     cfg = world.config
     B = need.shape[0]
     offsets = jnp.array(_OFFSETS, jnp.float32) * (math.pi / 4)
@@ -216,6 +223,19 @@ def first_free_alternative(world: World, s, xy, h0, need, chunk: int | None = No
     init = (jnp.int32(1), need, jnp.zeros(B, jnp.int32), jnp.zeros(B, bool))
     _, _, k, full = jax.lax.while_loop(cond, body, init)
     return k, full
+
+
+def _every_alternative(world: World, s, xy, h0, need, chunk: int | None):
+    """:func:`first_free_alternative`'s one-pass form (:func:`ignjax.sim.compact.one_pass`):
+    all seven alternatives probed for every row in ``need``, the first free one taken."""
+    B = need.shape[0]
+    offsets = jnp.array(_OFFSETS, jnp.float32) * (math.pi / 4)
+    step = jnp.float32(world.config.micro_step)
+    probe = jax.vmap(lambda s_, p, h: _probe(world, s_, p, h, step), in_axes=(None, None, 0))
+    ok, full = masked_map(lambda a: probe(a[0], a[1], a[2] + offsets[1:]), need, (s, xy, h0),
+                          (jnp.zeros((B, 7), bool), jnp.zeros((B, 7), bool)), chunk)
+    k = jnp.where(ok.any(1), jnp.argmax(ok, 1) + 1, 0).astype(jnp.int32)
+    return k, jnp.take_along_axis(full, jnp.maximum(k - 1, 0)[:, None], 1)[:, 0] & (k > 0)
 
 
 def execute_moves(world: World, states: T.SimState, direction, col, row, mask, chunk: int | None = None):

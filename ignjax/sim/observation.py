@@ -14,6 +14,7 @@ import jax
 import jax.numpy as jnp
 
 from ignjax.scenes import vocab
+from ignjax.sim import compact
 from ignjax.sim import geometry as G
 from ignjax.sim import types as T
 from ignjax.sim.rays import queries as SR
@@ -100,7 +101,10 @@ def sight_batch(world: World, states: T.SimState, mask, chunk: int | None = None
     compacted (:func:`ignjax.sim.compact.masked_map`); a sight line is not
     marched further when the instance's other sight line is already clear,
     nor at all for an instance out of range. Exact: each sample is the same
-    computation, and a ray's answer is decided by its first occupied sample."""
+    computation, and a ray's answer is decided by its first occupied sample.
+    Under :func:`ignjax.sim.compact.one_pass`, :func:`sight_of` of each selected row."""
+    if compact.ONE_PASS:
+        return _sight_one_pass(world, states, mask, chunk)
     cfg = world.config
     rays = world.bank.rays
     f_step, f_n = _free_samples(world)
@@ -147,6 +151,15 @@ def sight_batch(world: World, states: T.SimState, mask, chunk: int | None = None
     valid = jax.vmap(lambda s_, i_: world.bank.instances.valid[s_, i_])(s, idx)
     in_sight = jnp.any(clear, axis=-1) & valid & jnp.isfinite(dist) & mask[:, None]
     return Sight(free_space, idx, dist, in_sight)
+
+
+def _sight_one_pass(world: World, states: T.SimState, mask, chunk: int | None) -> Sight:
+    """:func:`sight_batch`'s one-pass form: :func:`sight_of` (every ray marched to its end) of the rows in ``mask``."""
+    B = mask.shape[0]
+    R, K = world.config.obs_rays_per_view, min(world.config.max_visible, world.bank.instances.valid.shape[1])
+    default = Sight(jnp.zeros((B, 8, R), jnp.float32), jnp.zeros((B, K), jnp.int32),
+                    jnp.full((B, K), jnp.inf, jnp.float32), jnp.zeros((B, K), bool))
+    return masked_map(lambda st: sight_of(world, st), mask, states, default, chunk)
 
 
 def observe(world: World, state: T.SimState, sight: Sight | None = None) -> T.Observation:

@@ -78,14 +78,21 @@ def check_record(res: dict) -> None:
     for name, a in lim["agents"].items():
         assert _positive(a["fraction"]) and _positive(a["work"]["gather_world"]), (name, a)
     assert all(_positive(v) for v in lim["rates"].values()), lim["rates"]
-    check_pieces(res["pieces"], ("random", "eig"))
+    check_pieces(res["pieces"], ("random", "eig"), decisions_within=PIECES_DECISIONS_WITHIN)
     s = res["studies"]
     assert set(s) == STUDY_KEYS
     assert s["in_loop_vectors"] == 16 and s["in_loop_episodes"] == 500  # --quick: K = 16
     assert all(_positive(v) for v in s.values()), s
 
 
-def check_pieces(block, agents):
+PIECES_DECISIONS_WITHIN = 0.01
+"""How far the pieces' decision count may stray from the fused rollout's at B = 4096 (README: compiled apart, they
+can round a float differently and change a rare episode; 0.3% of the EIG agent's decisions on the 2-core CPU)."""
+
+
+def check_pieces(block, agents, decisions_within: float = 0.0):
+    """The block's figures; its host loop takes the fused rollout's decisions, to within ``decisions_within``
+    of them (a share; 0: exactly)."""
     assert set(block["agents"]) == set(agents) and block["rows"] >= 1
     for name, a in block["agents"].items():
         us = a["us_per_decision"]
@@ -93,13 +100,15 @@ def check_pieces(block, agents):
         assert set(us) == set(PIECES) - ({"privileged"} if not privileged else set()) | {"sum", "whole"}, (name, us)
         assert all(_positive(v) for k, v in us.items() if k != "step_other"), (name, us)  # step_other: a difference
         assert math.isclose(us["sum"], sum(v for k, v in us.items() if k not in ("sum", "whole")))
-        # the host loop of separately compiled pieces takes the rollout's decisions
-        assert a["decisions"] == a["rollout_decisions"] > 0, (name, a)
+        # the host loop of separately compiled pieces takes the rollout's decisions, up to rounding's rare episodes
+        assert a["rollout_decisions"] > 0 and a["decisions"] > 0, (name, a)
+        assert abs(a["decisions"] - a["rollout_decisions"]) <= decisions_within * a["rollout_decisions"], (name, a)
 
 
 def test_pieces_follow_the_rollout(small_benchmark, small_world):
-    """The pieces, driven step by step from the host, take the same decisions
-    as the fused rollout of the same rows, and each has a time."""
+    """The pieces, driven step by step from the host, take exactly the
+    decisions of the fused rollout of the same rows (at this size no rounding
+    difference changes an episode), and each has a time."""
     block = bench_pieces(small_benchmark["set"], small_world, ("shortest_path",), 16, repeats=1)
     assert block["rows"] == 8 and block["batch"] == 16  # one device's share of 16 over the session's 2 devices
     check_pieces(block, ("shortest_path",))
