@@ -5,16 +5,31 @@ skip with the reason when it is absent. The core suite never needs it.
 
 The session runs with two CPU devices (``ignjax.devices.configure_cpu_devices``,
 set here before JAX starts; ``IGNJAX_CPU_DEVICES`` overrides the count), so
-rollouts are sharded over two devices unless a test says otherwise.
+rollouts are sharded over two devices unless a test says otherwise. The
+run shares one JAX persistent compilation cache (a temporary folder, or
+``JAX_COMPILATION_CACHE_DIR`` when set) among its xdist workers and the
+processes its tests start; outputs never depend on whether it was hit.
 
 ``two_room_scene``: a small hand-built scene (living room + bedroom, one
 door) with known instances, for tests that need exact expectations.
+
+Optional parts: the tests that need the vLLM server environment
+(``.ci/prepare-vllm``), a rendering backend (EGL or MuJoCo Warp), headless
+Chromium and its driver, or ``../shared`` carry the markers ``vllm``,
+``render``, ``browser`` and ``shared``. Outside CI such a test skips with the
+reason when its part is missing. With ``CI=true`` (where every part is set
+up) no test may skip: a skip is reported as a failure that quotes the skip's
+reason, so a missing part cannot leave the run green. The summary ends with
+how many tests of each optional part ran.
 """
 
 from __future__ import annotations
 
+import atexit
 import math
 import os
+import shutil
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -22,12 +37,106 @@ import pytest
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
+CACHE_MAX_BYTES = 4 << 30
+"""Size bound of the session's persistent compilation cache (oldest entries evicted first)."""
+if "JAX_COMPILATION_CACHE_DIR" not in os.environ:
+    # One persistent compilation cache for the whole run, set before JAX starts: the xdist workers and every
+    # process a test starts inherit it, so a program compiled in one is loaded, not compiled again, by the others
+    # (and after jax.clear_caches below). A size bound turns on JAX's file lock around every read and write, so
+    # processes never read an entry another is still writing. Removed when the run ends. A folder of your own in
+    # JAX_COMPILATION_CACHE_DIR is used instead and kept, so a second run loads what the first compiled.
+    _CACHE = tempfile.mkdtemp(prefix="ignjax-tests-jax-cache-")
+    os.environ["JAX_COMPILATION_CACHE_DIR"] = _CACHE
+    atexit.register(shutil.rmtree, _CACHE, True)
+os.environ.setdefault("JAX_COMPILATION_CACHE_MAX_SIZE", str(CACHE_MAX_BYTES))
 
 from ignjax.devices import configure_cpu_devices  # noqa: E402
 
 configure_cpu_devices(2)
 
 ROOT = Path(__file__).resolve().parents[1]
+IN_CI = os.environ.get("CI", "").strip().lower() not in ("", "0", "false", "no")
+"""``CI`` set to anything but empty/0/false/no: skips are failures."""
+OPTIONAL_PARTS = {"vllm": "vLLM", "render": "render", "browser": "browser", "shared": "../shared"}
+"""Marker -> name in the summary line of the optional parts."""
+_PART_COUNTS: dict[str, dict[str, int]] = {m: {} for m in OPTIONAL_PARTS}
+
+
+def _skip_reason(report) -> str:
+    longrepr = report.longrepr
+    if isinstance(longrepr, tuple) and len(longrepr) == 3:
+        return str(longrepr[2]).removeprefix("Skipped: ")
+    return str(longrepr)
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    """Under CI a skip (not an expected failure) becomes a failure naming the skip's reason."""
+    outcome = yield
+    report = outcome.get_result()
+    if IN_CI and report.skipped and not hasattr(report, "wasxfail"):
+        parts = [OPTIONAL_PARTS[m] for m in OPTIONAL_PARTS if item.get_closest_marker(m)]
+        need = f" ({', '.join(parts)})" if parts else ""
+        report.outcome = "failed"
+        report.longrepr = (f"CI=true and a part this test needs{need} is unavailable, so it fails instead of "
+                           f"skipping: {_skip_reason(report)}")
+
+
+FIXTURE_PARTS = {"vllm_server": "vllm", "rendering": "render", "browser": "browser", "shared_data": "shared"}
+"""A test that uses one of these fixtures needs that optional part (its marker is added at collection)."""
+
+
+VLLM_TESTS = "tests/agents/llm/vllm/"
+"""The live vLLM server's tests: one unit of work, so one worker starts that server once."""
+
+
+def work_unit(nodeid: str) -> str:
+    """The unit of work of a test under pytest-xdist: its file, or the vLLM folder."""
+    return VLLM_TESTS if nodeid.startswith(VLLM_TESTS) else nodeid.split("::", 1)[0]
+
+
+def pytest_collection_modifyitems(config, items):
+    """Marks each test with the optional parts its fixtures need."""
+    for item in items:
+        for fixture, marker in FIXTURE_PARTS.items():
+            if fixture in getattr(item, "fixturenames", ()) and not item.get_closest_marker(marker):
+                item.add_marker(getattr(pytest.mark, marker))
+
+
+def pytest_xdist_make_scheduler(config, log):
+    """Whole files to a worker (:func:`work_unit`): a file's module fixtures
+    and the programs its tests compile stay in one process. Units are handed
+    out in collection order, the next to whichever worker runs short."""
+    from xdist.scheduler import LoadScopeScheduling
+
+    class FileScheduling(LoadScopeScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            return work_unit(nodeid)
+
+    return FileScheduling(config, log)
+
+
+def pytest_runtest_logreport(report):
+    """Counts the outcome of every test of an optional part (in the controller under xdist too)."""
+    if report.when == "call" or (report.when == "setup" and not report.passed):
+        for marker in OPTIONAL_PARTS:
+            if marker in report.keywords:
+                outcome = "xfailed" if hasattr(report, "wasxfail") else report.outcome
+                counts = _PART_COUNTS[marker]
+                counts[outcome] = counts.get(outcome, 0) + 1
+
+
+def pytest_terminal_summary(terminalreporter):
+    """One line: how many tests of each optional part passed, failed or skipped."""
+    if getattr(terminalreporter.config, "workerinput", None) is not None:
+        return  # an xdist worker: the controller prints the line
+    parts = []
+    for marker, name in OPTIONAL_PARTS.items():
+        counts = _PART_COUNTS[marker]
+        text = ", ".join(f"{n} {k}" for k, n in sorted(counts.items())) or "none ran"
+        parts.append(f"{name}: {text}")
+    terminalreporter.write_line("optional parts" + (" (CI=true: skips fail)" if IN_CI else "") + ": "
+                                + "; ".join(parts))
 MAP_SHARE = 3
 """Compiled programs are dropped after a test file once the process holds
 more than 1/MAP_SHARE of the kernel's memory-mapping limit (below)."""
@@ -62,6 +171,19 @@ def _drop_compiled_programs():
         jax.clear_caches()
         gc.collect()
 SHARED_DATA = Path(os.environ.get("IGNJAX_SHARED_DATA", ROOT.parent / "shared" / "data"))
+
+
+@pytest.fixture(scope="session")
+def rendering() -> tuple[str, ...]:
+    """The rendering backends that work here (``"warp"``, ``"egl"``), or a
+    skip naming why neither does (a failure under CI)."""
+    from ignjax.sim.views.config import egl_available, warp_available
+
+    problems = {"warp": warp_available(), "egl": egl_available()}
+    backends = tuple(name for name, problem in problems.items() if problem is None)
+    if not backends:
+        pytest.skip("no rendering backend: " + "; ".join(f"{k}: {v}" for k, v in problems.items()))
+    return backends
 
 
 @pytest.fixture(scope="session")

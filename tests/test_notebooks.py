@@ -31,19 +31,10 @@ def test_notebook_is_stored_without_outputs(name):
         assert cell.execution_count is None, f"{name}: code cell {i} has an execution count"
 
 
-@pytest.fixture(scope="module")
-def jax_cache(tmp_path_factory):
-    """One persistent compilation cache for both notebooks: they build the
-    same small benchmark and run two of the same agents, so the second
-    notebook loads those rollouts instead of compiling them again."""
-    return tmp_path_factory.mktemp("jax_cache")
-
-
 @pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.slow) if n == "difficulty_ablation.ipynb" else n
                                   for n in NAMES])  # the difficulty notebook takes 80 s: run with -m slow
-def test_notebook_runs_and_shows_figures(name, tmp_path, monkeypatch, jax_cache):
+def test_notebook_runs_and_shows_figures(name, tmp_path, monkeypatch):
     monkeypatch.setenv("IGNJAX_NOTEBOOK_SMALL", "1")  # the kernel inherits the environment
-    monkeypatch.setenv("JAX_COMPILATION_CACHE_DIR", str(jax_cache))
     nb = _read(name)
     client = NotebookClient(nb, timeout=300, kernel_name="python3", resources={"metadata": {"path": str(tmp_path)}})
     client.execute()  # raises CellExecutionError (with the cell and traceback) on any error

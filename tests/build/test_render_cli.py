@@ -21,6 +21,7 @@ import pytest
 from ignjax.scenes.io.usd import save_usd
 
 SIZE = 64
+pytestmark = pytest.mark.render
 
 _PROBE = ("import mujoco\n"
           "m = mujoco.MjModel.from_xml_string(\"<mujoco><worldbody><geom size='1 1 .1' type='plane'/></worldbody></mujoco>\")\n"

@@ -23,11 +23,11 @@ from ignjax.agents.llm.client import ReplayMissError
 from ignjax.agents.llm.config import LLMConfig
 from ignjax.agents.llm.serve import ScriptedServer
 from ignjax.episodes.dataset import load_benchmark
+from ignjax.evaluate.cli import main as evaluate_main
 from ignjax.evaluate.hostloop import run_llm_agent
 from ignjax.evaluate.outcomes import read_outcomes
 from ignjax.sim import types as T
 from ignjax.sim.views import ViewConfig
-from ignjax.sim.views.config import egl_available, warp_available
 
 ROOT = Path(__file__).resolve().parents[2]
 EPISODES = ROOT / "scenes" / "benchmark.jsonl.gz"
@@ -52,13 +52,7 @@ def _same(a, b):
     return all(np.array_equal(x, y) for x, y in zip(jax.tree.leaves(a), jax.tree.leaves(b)))
 
 
-def _render_ok():
-    return warp_available() is None or egl_available() is None
-
-
-def test_vlm_end_to_end_cache_and_batch_independence(tmp_path, episodes):
-    if not _render_ok():
-        pytest.skip("no rendering backend")
+def test_vlm_end_to_end_cache_and_batch_independence(rendering, tmp_path, episodes):
     with ScriptedServer() as srv:
         res = run_llm_agent(episodes, VlmAgent(), _llm(srv, tmp_path / "cache"), sim=SIM, views=VIEWS, batch=3,
                             out=tmp_path / "a", save_images=1)
@@ -150,9 +144,10 @@ def test_replay_miss_names_the_request(tmp_path, episodes):
 
 
 def _evaluate(out: Path, url: str, cache: Path) -> list[str]:
-    return [sys.executable, "-m", "ignjax.evaluate", "--episodes", str(EPISODES), "--agent", "vlm",
-            "--llm-endpoint", url, "--llm-model", "ignjax-scripted", "--llm-cache", str(cache), "--limit", "3",
-            "--llm-batch", "2", "--set", "sim.max_steps=8", "--set", "views.size=64", "--out", str(out), "--quiet"]
+    """The arguments of ``python -m ignjax.evaluate`` for 3 vlm episodes."""
+    return ["--episodes", str(EPISODES), "--agent", "vlm", "--llm-endpoint", url, "--llm-model", "ignjax-scripted",
+            "--llm-cache", str(cache), "--limit", "3", "--llm-batch", "2", "--set", "sim.max_steps=8",
+            "--set", "views.size=64", "--out", str(out), "--quiet"]
 
 
 def _outcome_columns(path: Path) -> list[list[str]]:
@@ -161,37 +156,42 @@ def _outcome_columns(path: Path) -> list[list[str]]:
     return [r[:n] for r in rows]
 
 
-def test_resume_after_sigkill(tmp_path, monkeypatch):
+def _run_killed_after_first_episode(args: list[str], progress: Path) -> None:
+    """Run ``python -m ignjax.evaluate ARGS`` in a subprocess and SIGKILL it
+    once its progress file holds a finished episode (the kill is placed by
+    what the run writes, not by time)."""
+    proc = subprocess.Popen([sys.executable, "-m", "ignjax.evaluate", *args], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 600  # a bound on waiting, not a measurement
+    while time.monotonic() < deadline and proc.poll() is None:
+        if progress.exists() and len(progress.read_text().splitlines()) >= 2:  # header + one episode
+            break
+        time.sleep(0.05)
+    assert proc.poll() is None, "the run ended before it could be killed: " + proc.stderr.read()[-3000:]
+    proc.send_signal(signal.SIGKILL)
+    proc.communicate(timeout=30)
+    assert proc.returncode == -signal.SIGKILL
+
+
+def test_resume_after_sigkill(rendering, tmp_path, capsys):
     """A run killed with SIGKILL after its first finished episode resumes
     from its checkpoint and cache to the outcomes of an uninterrupted run;
-    a finished run started again sends no request."""
-    if not _render_ok():
-        pytest.skip("no rendering backend")
-    # the four processes share their compiled programs through JAX's persistent cache
-    monkeypatch.setenv("JAX_COMPILATION_CACHE_DIR", str(tmp_path / "jax_cache"))
+    a finished run started again sends no request. The killed and the
+    resumed run are processes of their own (sharing their compiled programs
+    through the run's persistent compilation cache, tests/conftest.py); the
+    uninterrupted run and the repeat run in this process."""
     with ScriptedServer(latency=0.4) as srv:
         url = srv.base_url
-        full = subprocess.run(_evaluate(tmp_path / "full", url, tmp_path / "cache_full"), capture_output=True,
-                              text=True, timeout=900)
-        assert full.returncode == 0, full.stderr[-3000:]
+        assert evaluate_main(_evaluate(tmp_path / "full", url, tmp_path / "cache_full")) == 0
         n_full = srv.stats()["requests"]
 
         out = tmp_path / "killed"
-        progress = out / "llm" / "vlm.progress.jsonl"
-        proc = subprocess.Popen(_evaluate(out, url, tmp_path / "cache"), stdout=subprocess.DEVNULL,
-                                stderr=subprocess.DEVNULL)
-        deadline = time.monotonic() + 600
-        while time.monotonic() < deadline and proc.poll() is None:
-            if progress.exists() and len(progress.read_text().splitlines()) >= 2:  # header + one episode
-                break
-            time.sleep(0.05)
-        assert proc.poll() is None, "the run ended before it could be killed"
-        proc.send_signal(signal.SIGKILL)
-        proc.wait(timeout=30)
+        _run_killed_after_first_episode(_evaluate(out, url, tmp_path / "cache"), out / "llm" / "vlm.progress.jsonl")
         n_killed = srv.stats()["requests"] - n_full
         assert 0 < n_killed < n_full
 
-        resumed = subprocess.run(_evaluate(out, url, tmp_path / "cache"), capture_output=True, text=True, timeout=900)
+        resumed = subprocess.run([sys.executable, "-m", "ignjax.evaluate", *_evaluate(out, url, tmp_path / "cache")],
+                                 capture_output=True, text=True, timeout=900)
         assert resumed.returncode == 0, resumed.stderr[-3000:]
         assert "from an earlier run" in resumed.stderr
         n_resumed = srv.stats()["requests"] - n_full - n_killed
@@ -200,9 +200,10 @@ def test_resume_after_sigkill(tmp_path, monkeypatch):
         assert _outcome_columns(out / "outcomes.csv") == _outcome_columns(tmp_path / "full" / "outcomes.csv")
 
         before = srv.stats()["requests"]
-        again = subprocess.run(_evaluate(out, url, tmp_path / "cache"), capture_output=True, text=True, timeout=900)
-        assert again.returncode == 0, again.stderr[-3000:]
-        assert srv.stats()["requests"] == before and "0 requests sent" in again.stderr
+        capsys.readouterr()
+        assert evaluate_main(_evaluate(out, url, tmp_path / "cache")) == 0
+        again = capsys.readouterr()
+        assert srv.stats()["requests"] == before and "0 requests sent" in again.err
         run = json.loads((out / "run.json").read_text())
         assert run["model_totals"]["vlm"]["requests"] + run["model_totals"]["vlm"]["cache_hits"] > 0
         # the printed summary's per-episode figures are those of the outcome rows (calls answered from the cache
@@ -212,6 +213,6 @@ def test_resume_after_sigkill(tmp_path, monkeypatch):
                          for k in ("requests", "prompt_tokens", "completion_tokens"))
         assert (f"vlm: per episode (mean / max over 3): {np.mean(calls):.1f} / {max(calls)} model calls, "
                 f"{np.mean(pt):.0f} / {max(pt)} prompt tokens, {np.mean(ct):.0f} / {max(ct)} completion tokens\n"
-                in again.stdout), again.stdout
+                in again.out), again.out
         assert run["model_totals"]["vlm"]["per_episode"]["calls"]["max"] == max(calls)
         assert all(np.isnan(r["cost_usd"]) for r in rows)

@@ -394,6 +394,7 @@ def _egl_available() -> str | None:
     return None
 
 
+@pytest.mark.render
 def test_gallery_writes_png(tmp_path):
     reason = _egl_available()
     if reason:

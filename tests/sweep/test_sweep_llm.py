@@ -22,7 +22,6 @@ from ignjax.agents.llm.serve import ScriptedServer, scripted_reply
 from ignjax.studies.interaction import CONTENT_CLASSES, classify_question
 from ignjax.config import fingerprint, resolve
 from ignjax.errors import ConfigError
-from ignjax.sim.views.config import egl_available, warp_available
 from ignjax.sweep.cli import main
 from ignjax.sweep.stages import run_sweep
 
@@ -67,8 +66,7 @@ def _rows(path: Path) -> list[dict]:
         return list(csv.DictReader(f))
 
 
-@pytest.mark.skipif(warp_available() is not None and egl_available() is not None, reason="no rendering backend")
-def test_sweep_eval_runs_an_mllm_agent_and_reruns_from_the_cache(tmp_path, capsys):
+def test_sweep_eval_runs_an_mllm_agent_and_reruns_from_the_cache(rendering, tmp_path, capsys):
     with ScriptedServer(policy=_policy) as srv:
         sets = _sets(srv, tmp_path, tmp_path / "cache")
         argv = ["--study", "eval,analysis", "--quiet", "--out", str(tmp_path / "a")] + sum((["--set", s] for s in sets), [])

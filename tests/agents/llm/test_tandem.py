@@ -27,13 +27,11 @@ from ignjax.evaluate.hostloop import run_llm_agent
 from ignjax.sim import oracle_text as OT
 from ignjax.sim import types as T
 from ignjax.sim.views import ViewConfig
-from ignjax.sim.views.config import egl_available, warp_available
 
 ROOT = Path(__file__).resolve().parents[3]
 EPISODES = ROOT / "scenes" / "benchmark.jsonl.gz"
 VIEWS = ViewConfig(size=64)
-render_ok = pytest.mark.skipif(warp_available() is not None and egl_available() is not None,
-                               reason="no rendering backend")
+render_ok = pytest.mark.usefixtures("rendering")
 
 
 def _decision(step=3, questions_left=5, n_views=8, answers=(), last_move="", **percept):

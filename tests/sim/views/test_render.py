@@ -35,6 +35,7 @@ from ignjax.sim.views.config import egl_available, warp_available
 from ignjax.sim.world import World
 
 ROOT = Path(__file__).resolve().parents[3]
+pytestmark = pytest.mark.render
 SIZE = 120
 POSES = 3
 

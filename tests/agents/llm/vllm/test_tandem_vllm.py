@@ -15,7 +15,6 @@ from ignjax.episodes.dataset import load_benchmark
 from ignjax.evaluate.hostloop import run_llm_agent
 from ignjax.sim import types as T
 from ignjax.sim.views import ViewConfig
-from ignjax.sim.views.config import egl_available, warp_available
 
 ROOT = Path(__file__).resolve().parents[4]
 
@@ -23,9 +22,7 @@ pytestmark = pytest.mark.vllm
 
 
 @pytest.mark.parametrize("name", ["tandem", "coin", "navgpt"])
-def test_tandem_and_baselines_against_vllm(vllm_server, tmp_path, name):
-    if warp_available() is not None and egl_available() is not None:
-        pytest.skip("no rendering backend")
+def test_tandem_and_baselines_against_vllm(vllm_server, rendering, tmp_path, name):
     es = load_benchmark(ROOT / "scenes" / "benchmark.jsonl.gz", limit=2)
     llm = LLMConfig(endpoints=(vllm_server.base_url,), model=vllm_server.model, api_key_env=None, max_tokens=700,
                     cache_dir=str(tmp_path / "cache"), concurrency=8, timeout_s=120.0)

@@ -16,16 +16,13 @@ from ignjax.episodes.dataset import load_benchmark
 from ignjax.evaluate.hostloop import run_llm_agent
 from ignjax.sim import types as T
 from ignjax.sim.views import ViewConfig
-from ignjax.sim.views.config import egl_available, warp_available
 
 ROOT = Path(__file__).resolve().parents[4]
 
 pytestmark = pytest.mark.vllm
 
 
-def test_vlm_agent_against_vllm(vllm_server, tmp_path):
-    if warp_available() is not None and egl_available() is not None:
-        pytest.skip("no rendering backend")
+def test_vlm_agent_against_vllm(vllm_server, rendering, tmp_path):
     es = load_benchmark(ROOT / "scenes" / "benchmark.jsonl.gz", limit=3)
     llm = LLMConfig(endpoints=(vllm_server.base_url,), model=vllm_server.model, api_key_env=None, max_tokens=96,
                     cache_dir=str(tmp_path / "cache"), concurrency=8, timeout_s=120.0)
