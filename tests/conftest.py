@@ -95,8 +95,22 @@ def work_unit(nodeid: str) -> str:
     return VLLM_TESTS if nodeid.startswith(VLLM_TESTS) else nodeid.split("::", 1)[0]
 
 
+HEAVY_UNITS = (
+    "tests/agents/test_agents.py", "tests/sweep/test_sweep.py", "tests/agents/llm/test_tandem.py", VLLM_TESTS,
+    "tests/sim/test_sim.py", "tests/evaluate/test_buckets.py", "tests/devices/test_processes.py",
+    "tests/sweep/test_sweep_llm.py", "tests/evaluate/test_hostloop.py", "tests/sim/test_sharding.py",
+    "tests/test_notebooks.py", "tests/build/test_build_workers.py",
+)
+"""The units of work that take longest on the 2-core CI machine, longest
+first: they are handed out before the others, so the run does not end with
+one worker on a long file while the other waits."""
+
+
 def pytest_collection_modifyitems(config, items):
-    """Marks each test with the optional parts its fixtures need."""
+    """Marks each test with the optional parts its fixtures need, and puts
+    the tests of :data:`HEAVY_UNITS` first (in that order; the rest keep theirs)."""
+    rank = {unit: i for i, unit in enumerate(HEAVY_UNITS)}
+    items.sort(key=lambda item: rank.get(work_unit(item.nodeid), len(rank)))
     for item in items:
         for fixture, marker in FIXTURE_PARTS.items():
             if fixture in getattr(item, "fixturenames", ()) and not item.get_closest_marker(marker):

@@ -4,13 +4,15 @@ bank for fast collision and free-space rays.
 
 The probe map (:func:`probe_map`, one bit per probe height on cells a
 :data:`FINE`-th of a navigation cell) is built on the host when a World is
-made; :func:`fine_at`, :func:`packed_at`, :func:`march_free` and
+made (once per process for the same bank, :func:`remembered_probe_map`); :func:`fine_at`, :func:`packed_at`, :func:`march_free` and
 :func:`probe_free` read it inside a rollout.
 """
 
 from __future__ import annotations
 
+import hashlib
 import math
+from collections import OrderedDict
 
 import jax
 import jax.numpy as jnp
@@ -58,7 +60,7 @@ class World:
 
     def __post_init__(self):
         if self.fine is None:
-            object.__setattr__(self, "fine", probe_map(self.bank, self.config))
+            object.__setattr__(self, "fine", remembered_probe_map(self.bank, self.config))
         n_col = len(self.config.collision_heights)
         if self.packed_obs is None:
             object.__setattr__(self, "packed_obs", pack_probe_map(self.fine, (1 << n_col, 1 << (n_col + 1))))
@@ -150,6 +152,43 @@ def probe_map(bank: SceneBank, config: T.SimConfig) -> jax.Array:
             bits |= (np.where(inside, occ, False).astype(np.uint8) << j)
         out[si] = bits
     return jnp.asarray(out)
+
+
+PROBE_MAPS_KEPT = 8
+"""Probe maps a process keeps (:func:`remembered_probe_map`), the latest used."""
+_PROBE_MAPS: OrderedDict[bytes, np.ndarray] = OrderedDict()
+
+
+def _probe_map_key(bank: SceneBank, config: T.SimConfig) -> bytes:
+    """A digest of everything :func:`probe_map` reads: the bank's ray grid
+    and navigation-grid geometry and the probe heights."""
+    g, r = bank.grid, bank.rays
+    h = hashlib.blake2b(digest_size=20)
+    parts = (np.asarray(g.navigable).shape, g.origin, g.resolution, r.voxcode, r.seg_start, r.seg_count, r.seg_prims,
+             r.approx, r.prims, r.origin, r.dims, r.resolution, r.slice_height, r.slices_per_band,
+             probe_heights(config))
+    for part in parts:
+        a = np.ascontiguousarray(np.asarray(part))
+        h.update(f"{a.dtype}{a.shape}".encode())
+        h.update(a.tobytes())
+    return h.digest()
+
+
+def remembered_probe_map(bank: SceneBank, config: T.SimConfig) -> jax.Array:
+    """:func:`probe_map`, computed once per process for the same inputs (the
+    last :data:`PROBE_MAPS_KEPT`, keyed by a digest of what it reads): a run
+    that builds several Worlds of one bank (a bucket, an MLLM agent's host
+    loop, a second run in a notebook) pays for it once. The same array as
+    :func:`probe_map` (it is that array)."""
+    key = _probe_map_key(bank, config)
+    hit = _PROBE_MAPS.get(key)
+    if hit is None:
+        hit = np.asarray(probe_map(bank, config))
+        _PROBE_MAPS[key] = hit
+        while len(_PROBE_MAPS) > PROBE_MAPS_KEPT:
+            _PROBE_MAPS.popitem(last=False)
+    _PROBE_MAPS.move_to_end(key)
+    return jnp.asarray(hit)
 
 
 def _fine_index(world: World, s, xy):

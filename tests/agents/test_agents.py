@@ -174,12 +174,12 @@ def test_question_eigs_equal_eq1_on_explicit_answer_models(small_benchmark, smal
     specs, keys = _batch(es)
     agent = get_agent("eig")
     params = agent.default_params()
-    state = jax.vmap(lambda s: E.reset(small_world, s))(specs)
-    obs = jax.vmap(lambda st: E.observe(small_world, st))(state)
-    pst = jax.vmap(lambda o, k: agent.init(params, o, k))(obs, keys)
+    observe = jax.jit(jax.vmap(lambda st: E.observe(small_world, st)))
+    state = jax.jit(jax.vmap(lambda s: E.reset(small_world, s)))(specs)
+    obs = observe(state)
+    pst = jax.jit(jax.vmap(lambda o, k: agent.init(params, o, k)))(obs, keys)
     act = jax.jit(jax.vmap(lambda o, a, p, k: agent.act(params, o, a, p, k, None)))
     step = jax.jit(jax.vmap(lambda st, a: E.step(small_world, st, a)))
-    observe = jax.jit(jax.vmap(lambda st: E.observe(small_world, st)))
 
     def check(o, ans, mem):
         mem, b = B.update_belief(params, o, ans, mem)
@@ -220,8 +220,62 @@ def _rows_matching(got, want) -> np.ndarray:
     return ok
 
 
+def _one_program(agents: list[Agent]) -> Agent:
+    """One agent that acts as ``agents[i]`` where its parameters are
+    ``(i, (every agent's parameters))``: every agent's state is carried and
+    the selected one's ``act`` is applied (``lax.switch``), so one compiled
+    reference program (one copy of the simulator) serves them all; the
+    privileged information reaches the privileged agent only."""
+
+    def init(params, obs, key):
+        return tuple(a.init(p, obs, key) for a, p in zip(agents, params[1]))
+
+    def act(params, obs, answers, pstate, key, priv):
+        i, ps = params
+
+        def branch(j):
+            def run(_):
+                a = agents[j]
+                action, new = a.act(ps[j], obs, answers, pstate[j], key, priv if a.privileged else None)
+                action = jax.tree.map(lambda x: jnp.asarray(x, jnp.int32), action)
+                return action, tuple(new if k == j else pstate[k] for k in range(len(agents)))
+            return run
+
+        return jax.lax.switch(i, [branch(j) for j in range(len(agents))], None)
+
+    return Agent("one_program", init, act, lambda: None, privileged=any(a.privileged for a in agents))
+
+
+def _params_of(name, runs):
+    """The parameters the batch rollout of ``name`` ran with (eig: the cost sweep's x1 row)."""
+    if name == "eig":
+        return jax.tree.map(lambda a: a[SCALES.index(1.0)], runs["eig_params"])
+    return get_agent(name).default_params()
+
+
+@pytest.fixture(scope="module")
+def references(small_benchmark, small_world, runs):
+    """Every registered agent's episodes through the one-episode reference
+    ``rollout_episode`` under vmap, compiled with the rollout's options, as
+    one program (:func:`_one_program`): {name: (outcomes, trajectory)}."""
+    es = small_benchmark["set"]
+    specs, keys = _batch(es)
+    names = sorted(registry())
+    n = keys.shape[0]
+    multi = _one_program([get_agent(a) for a in names])
+    every = tuple(_params_of(a, runs) for a in names)
+    rows = np.repeat(np.arange(len(names)), n)
+    params = (jnp.asarray(rows, jnp.int32),
+              jax.tree.map(lambda x: jnp.broadcast_to(x, (rows.size,) + jnp.shape(x)), every))
+    tile = np.tile(np.arange(n), len(names))
+    ref = jax.jit(jax.vmap(lambda p, s, key: rollout_episode(small_world, s, multi, p, key)[:2]),
+                  compiler_options=ROLLOUT_COMPILER_OPTIONS)(params, jax.tree.map(lambda a: a[tile], specs), keys[tile])
+    ref = jax.tree.map(np.asarray, ref)
+    return {a: jax.tree.map(lambda x: x[j * n:(j + 1) * n], ref) for j, a in enumerate(names)}
+
+
 @pytest.mark.parametrize("name", sorted(registry()))
-def test_batched_rollout_equals_one_episode_rollout(small_benchmark, small_world, runs, name):
+def test_batched_rollout_equals_one_episode_rollout(small_benchmark, small_world, runs, references, name):
     """The batch rollout (executor for the movers only, oracle for the askers
     only, nothing for finished rows; rollout_sweep's K x E rows) gives row for
     row what the one-episode reference ``rollout_episode`` gives under vmap,
@@ -235,15 +289,24 @@ def test_batched_rollout_equals_one_episode_rollout(small_benchmark, small_world
     specs, keys = _batch(es)
     agent = get_agent(name)
     if name == "eig":
-        k = SCALES.index(1.0)
-        params, got = jax.tree.map(lambda a: a[k], runs["eig_params"]), _sweep_row(runs, k)
+        got = _sweep_row(runs, SCALES.index(1.0))
     else:
-        params = agent.default_params()
-        got = runs[name] if name in runs else jax.tree.map(np.asarray, rollout(small_world, specs, agent, params, keys))
-    ref = jax.jit(jax.vmap(lambda s, key: rollout_episode(small_world, s, agent, params, key)[:2]),
-                  compiler_options=ROLLOUT_COMPILER_OPTIONS)(specs, keys)
-    same = _rows_matching(got, ref)
+        got = runs[name] if name in runs else jax.tree.map(
+            np.asarray, rollout(small_world, specs, agent, _params_of(name, runs), keys))
+    same = _rows_matching(got, references[name])
     assert same.mean() >= 0.95, f"{name}: {int((~same).sum())} of {same.size} episodes differ: {np.flatnonzero(~same)}"
+
+
+def test_one_program_reference_is_each_agents_own(small_benchmark, small_world, references):
+    """The combined reference program runs each agent as its own reference
+    would: checked against ``rollout_episode`` of one agent alone (the cheapest), exactly."""
+    es = small_benchmark["set"]
+    specs, keys = _batch(es)
+    agent = get_agent("random")
+    alone = jax.jit(jax.vmap(lambda s, key: rollout_episode(small_world, s, agent, agent.default_params(), key)[:2]),
+                    compiler_options=ROLLOUT_COMPILER_OPTIONS)(specs, keys)
+    same = _rows_matching(jax.tree.map(np.asarray, alone), references["random"])
+    assert same.all(), np.flatnonzero(~same)
 
 
 def test_sweep_simulates_each_distinct_trajectory_once_with_the_same_result(small_benchmark, small_world, runs):
@@ -273,7 +336,7 @@ def test_sweep_simulates_each_distinct_trajectory_once_with_the_same_result(smal
 
 def test_visit_counts_saturate_instead_of_wrapping(small_benchmark, small_world):
     spec = jax.tree.map(lambda a: a[0], small_benchmark["set"].specs)
-    obs = E.observe(small_world, E.reset(small_world, spec))
+    obs = jax.jit(lambda sp: E.observe(small_world, E.reset(small_world, sp)))(spec)
     ij = np.asarray(visit_index(obs.odometry[:2]))
     mem = Memory.empty()
     once = observe_memory(mem, obs)

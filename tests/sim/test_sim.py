@@ -112,6 +112,22 @@ def test_collision_rays_stop_motion_within_collision_distance(small_benchmark, s
             assert turn >= math.pi / 4 - 1e-3 or along < 0.6
 
 
+def test_probe_map_is_computed_once_per_bank_and_settings(small_world):
+    """A second World of the same bank and probe heights reuses the probe map
+    (the same array as computing it); another bank or another height does not."""
+    w = small_world
+    W._PROBE_MAPS.clear()
+    again = W.World(w.bank, w.fields, w.config)
+    np.testing.assert_array_equal(np.asarray(again.fine), np.asarray(W.probe_map(w.bank, w.config)))
+    assert len(W._PROBE_MAPS) == 1
+    W.World(w.bank, w.fields, w.config)
+    assert len(W._PROBE_MAPS) == 1
+    taller = dataclasses.replace(w.config, eye_height=w.config.eye_height + 0.3)
+    assert W._probe_map_key(w.bank, taller) != W._probe_map_key(w.bank, w.config)
+    rays = dataclasses.replace(w.bank.rays, voxcode=w.bank.rays.voxcode.at[0, 0, 0, 0].add(1))
+    assert W._probe_map_key(dataclasses.replace(w.bank, rays=rays), w.config) != W._probe_map_key(w.bank, w.config)
+
+
 def test_packed_observation_map_equals_probe_map(small_world):
     """The observation's packed probe map answers exactly as the fine probe map,
     inside the grid, on its edges and outside it."""

@@ -18,14 +18,14 @@ DATA = re.compile(r'<script type="application/json" id="ignjax-data">(.*?)</scri
 
 def test_sweep_writes_and_links_the_viewer(small_benchmark, tmp_path):
     sets = [f"benchmark.episodes='{small_benchmark['path']}'", f"run.out='{tmp_path}'", "run.name='viewer-check'",
-            "eval.agents=['random', 'explorer']", "eval.batch=16", "benchmark.limit=12"]
+            "eval.agents=['random', 'explorer']", "eval.batch=8", "benchmark.limit=16"]
     out = tmp_path / "sweep"
     run_sweep(resolve(None, sets, quick=True), ["eval"], out, quiet=True)
     report = (out / "report.md").read_text()
     assert "[viewer.html](viewer.html)" in report
     meta, traj = read_trajectories(out / "trajectories.npz")
     rows = read_outcomes(out / "outcomes.parquet")
-    assert meta["agents"] == ["random", "explorer"] and len(meta["episode_ids"]) == 12
+    assert meta["agents"] == ["random", "explorer"] and len(meta["episode_ids"]) == 16
     assert [r["episode_id"] for r in rows if r["agent"] == "random"] == meta["episode_ids"]
     for a in meta["agents"]:
         steps = [r["steps"] for r in rows if r["agent"] == a]

@@ -253,14 +253,17 @@ def march_resume(grid: RayGrid, scene, pnt, vec, max_dist, state: MarchState, *,
         grid, scene, pnt, vec, max_dist, static_range=static_range, outside_hits=outside_hits,
         include_floor=include_floor, exact=exact, iterations=iterations)
     rounds = EXACT_ROUNDS if exact else 1
-    carry = state.carry
-    result, pending = jnp.float32(jnp.inf), jnp.array(True)
-    for r in range(rounds):
-        if r == 0:
-            carry = jax.lax.fori_loop(min(steps, n_iter), n_iter, body, carry)
-        else:
-            carry = jax.lax.fori_loop(0, max(n_iter // 4, 1), body, (*carry[:3], *_fresh(carry)))
+    carry = jax.lax.fori_loop(min(steps, n_iter), n_iter, body, state.carry)
+    result, pending = _round(exact_test, exact, 0, rounds, carry, jnp.array(True), jnp.float32(jnp.inf))
+
+    def again(r, c):  # a later round: a shorter traversal from where the last one stopped, and its exact test
+        carry, result, pending = c
+        carry = jax.lax.fori_loop(0, max(n_iter // 4, 1), body, (*carry[:3], *_fresh(carry)))
         result, pending = _round(exact_test, exact, r, rounds, carry, pending, result)
+        return carry, result, pending
+
+    if rounds > 1:  # one loop, not the rounds unrolled: the same steps, a program a fraction of the size
+        carry, result, pending = jax.lax.fori_loop(1, rounds, again, (carry, result, pending))
     return finish(result)
 
 
