@@ -22,7 +22,7 @@ from ignjax.sim import queries as Q
 from ignjax.sim import types as T
 from ignjax.sim import world as W
 from ignjax.sim.rays import queries as SR
-from ignjax.sim.rollout import rollout, rollout_episode
+from ignjax.sim.rollout import ROLLOUT_COMPILER_OPTIONS, rollout, rollout_episode
 
 
 def _spec(es, k):
@@ -365,9 +365,10 @@ def test_observation_is_identical_when_target_swapped_for_a_distractor(small_ben
 def test_vmapped_results_do_not_depend_on_batch_size_or_position(small_benchmark, small_world, random_runs):
     es = small_benchmark["set"]
     agent = get_agent("random")
-    params = agent.default_params()
     keys = jax.random.split(jax.random.key(0), len(es))
-    run = jax.jit(jax.vmap(lambda s, k: rollout_episode(small_world, s, agent, params, k)[:2]))
+    # the rollout's compiler options, as tests/agents/test_agents.py's reference of this agent: one compiled program
+    run = jax.jit(jax.vmap(lambda s, key: rollout_episode(small_world, s, agent, agent.default_params(), key)[:2]),
+                  compiler_options=ROLLOUT_COMPILER_OPTIONS)
     full = jax.tree.map(np.asarray, run(es.specs, keys))
     perm = np.random.default_rng(0).permutation(len(es))
     permuted = jax.tree.map(np.asarray, run(jax.tree.map(lambda a: a[perm], es.specs), keys[perm]))
