@@ -4,8 +4,9 @@ bank for fast collision and free-space rays.
 
 The probe map (:func:`probe_map`, one bit per probe height on cells a
 :data:`FINE`-th of a navigation cell) is built on the host when a World is
-made (once per process for the same bank, :func:`remembered_probe_map`); :func:`fine_at`, :func:`packed_at`, :func:`march_free` and
-:func:`probe_free` read it inside a rollout.
+made (once per process for the same bank: :func:`remembered_probe_map`);
+:func:`fine_at`, :func:`packed_at`, :func:`march_free` and :func:`probe_free`
+read it inside a rollout.
 """
 
 from __future__ import annotations
@@ -101,7 +102,13 @@ def _inside_prims(prims: np.ndarray, pts: np.ndarray, grow: float = 0.0) -> np.n
 
 
 def probe_map(bank: SceneBank, config: T.SimConfig) -> jax.Array:
-    """(S, FINE H, FINE W) uint8 probe bits on fine cells (see :class:`World`).
+    """(S, FINE H, FINE W) uint8 probe bits on fine cells (see :class:`World`;
+    computed on the host by :func:`_probe_bits`)."""
+    return jnp.asarray(_probe_bits(bank, config))
+
+
+def _probe_bits(bank: SceneBank, config: T.SimConfig) -> np.ndarray:
+    """:func:`probe_map` as a host array.
 
     A fine cell's bit for height h is set when its centre at height h lies
     inside a primitive of its voxel's column segment grown by
@@ -151,7 +158,7 @@ def probe_map(bank: SceneBank, config: T.SimConfig) -> jax.Array:
                     occ[part] = hit
             bits |= (np.where(inside, occ, False).astype(np.uint8) << j)
         out[si] = bits
-    return jnp.asarray(out)
+    return out
 
 
 PROBE_MAPS_KEPT = 8
@@ -182,8 +189,8 @@ def remembered_probe_map(bank: SceneBank, config: T.SimConfig) -> jax.Array:
     :func:`probe_map` (it is that array)."""
     key = _probe_map_key(bank, config)
     hit = _PROBE_MAPS.get(key)
-    if hit is None:
-        hit = np.asarray(probe_map(bank, config))
+    if hit is None:  # kept on the host: a device holds only the Worlds' own copies
+        hit = _probe_bits(bank, config)
         _PROBE_MAPS[key] = hit
         while len(_PROBE_MAPS) > PROBE_MAPS_KEPT:
             _PROBE_MAPS.popitem(last=False)
