@@ -5,13 +5,15 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+_TMP = ".tmp-"  # between a file's name and the writing process's id
+
 
 def atomic_write(path: str | os.PathLike, data: bytes | str) -> Path:
     """Write ``data`` (text is UTF-8 encoded) to a temporary name in the same
     folder, then rename it over ``path``; the folder is created if needed."""
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
-    tmp = p.with_name(f".{p.name}.tmp-{os.getpid()}")
+    tmp = p.with_name(f".{p.name}{_TMP}{os.getpid()}")
     try:
         tmp.write_bytes(data.encode("utf-8") if isinstance(data, str) else data)
         os.replace(tmp, p)
@@ -21,4 +23,20 @@ def atomic_write(path: str | os.PathLike, data: bytes | str) -> Path:
     return p
 
 
-__all__ = ["atomic_write"]
+def remove_leftover_temporaries(folder: str | os.PathLike) -> int:
+    """Delete the temporary files that :func:`atomic_write` leaves when its
+    process is killed mid-write (SIGKILL skips the clean-up), anywhere under
+    ``folder``; call it only on a folder no other live process writes into.
+
+    Returns:
+        How many files were deleted.
+    """
+    n = 0
+    for tmp in Path(folder).rglob(f".*{_TMP}*"):
+        if tmp.is_file():
+            tmp.unlink(missing_ok=True)
+            n += 1
+    return n
+
+
+__all__ = ["atomic_write", "remove_leftover_temporaries"]

@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from ignjax.errors import InputError
-from ignjax.fileio import atomic_write
+from ignjax.fileio import atomic_write, remove_leftover_temporaries
 
 MANIFEST = "manifest.json"
 
@@ -85,8 +85,8 @@ class PartStore:
         same = manifest.is_file() and json.loads(manifest.read_text()).get("fingerprint") == fingerprint
         if not (resume and same) and self.root.exists():
             shutil.rmtree(self.root)
-        for tmp in self.root.glob("*/.*.tmp-*"):  # a part being written when its process died
-            tmp.unlink(missing_ok=True)
+        if self.root.exists():
+            remove_leftover_temporaries(self.root)  # a part being written when its process died
         atomic_write(manifest, json.dumps({"fingerprint": fingerprint}) + "\n")
         return sum(1 for _ in self.root.glob("*/part_*.npz"))
 

@@ -12,7 +12,7 @@ import orbax.checkpoint as ocp
 
 from ignjax.config import SweepConfig, fingerprint
 from ignjax.errors import InputError
-from ignjax.fileio import atomic_write
+from ignjax.fileio import atomic_write, remove_leftover_temporaries
 
 
 def prepare_folder(out: Path, cfg: SweepConfig, studies: list[str], resume: bool, force: bool) -> None:
@@ -33,6 +33,7 @@ def prepare_folder(out: Path, cfg: SweepConfig, studies: list[str], resume: bool
             if not resume:
                 raise InputError(str(out), "--out", "the folder already holds this run; use --resume to continue "
                                                     "it or --force to start over")
+            remove_leftover_temporaries(out)  # a file being written when the killed run stopped
     out.mkdir(parents=True, exist_ok=True)
     if not meta.is_file():
         atomic_write(meta, json.dumps({"fingerprint": fp, "studies": studies, "config": cfg.to_dict()}, indent=2,

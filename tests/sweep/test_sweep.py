@@ -27,7 +27,7 @@ from ignjax.config import (CostsConfig, DifficultyConfig, EvalConfig, SweepConfi
 from ignjax.errors import ConfigError, InputError
 from ignjax.protocol import LOCKED_COSTS
 from ignjax.sim.types import SimConfig
-from ignjax.sweep.checkpoints import Checkpoints
+from ignjax.sweep.checkpoints import Checkpoints, prepare_folder
 from ignjax.sweep.cli import main
 from ignjax.sweep.stages import run_sweep
 
@@ -358,6 +358,22 @@ def test_checkpoint_stage_is_absent_until_complete(tmp_path):
     assert ck.has("eval/x") and not stale.exists()
     got = ck.load("eval/x")
     assert np.array_equal(got["out"]["a"], tree["out"]["a"]) and np.array_equal(got["costs"], tree["costs"])
+
+
+def test_resume_deletes_what_a_killed_write_left_and_nothing_else(tmp_path):
+    """A run killed inside atomic_write leaves ``.<name>.tmp-<pid>``; --resume deletes it, keeps the rest."""
+    cfg, out = resolve(None, ["costs.samples=7"]), tmp_path / "run"
+    prepare_folder(out, cfg, ["eval"], resume=False, force=False)
+    (out / "figures").mkdir()
+    left = [out / ".outcomes.csv.tmp-4242", out / "figures" / ".costs_in_loop.png.tmp-4243"]
+    kept = [out / "outcomes.csv", out / "figures" / "costs_in_loop.png", out / "notes.tmp-1"]
+    for p in left + kept:
+        p.write_text("x")
+    with pytest.raises(InputError, match="--resume"):
+        prepare_folder(out, cfg, ["eval"], resume=False, force=False)
+    assert all(p.exists() for p in left)  # a refused call changes nothing
+    prepare_folder(out, cfg, ["eval"], resume=True, force=False)
+    assert not any(p.exists() for p in left) and all(p.exists() for p in kept)
 
 
 def test_every_study_has_one_report_section_in_the_same_order():
