@@ -8,7 +8,8 @@ set here before JAX starts; ``IGNJAX_CPU_DEVICES`` overrides the count), so
 rollouts are sharded over two devices unless a test says otherwise. The
 run shares one JAX persistent compilation cache (a temporary folder, or
 ``JAX_COMPILATION_CACHE_DIR`` when set) among its xdist workers and the
-processes its tests start; outputs never depend on whether it was hit.
+processes its tests start, and one ignjax cache folder (``IGNJAX_CACHE_DIR``:
+scene grids and goal fields); outputs never depend on whether they were hit.
 
 ``two_room_scene``: a small hand-built scene (living room + bedroom, one
 door) with known instances, for tests that need exact expectations.
@@ -49,6 +50,12 @@ if "JAX_COMPILATION_CACHE_DIR" not in os.environ:
     os.environ["JAX_COMPILATION_CACHE_DIR"] = _CACHE
     atexit.register(shutil.rmtree, _CACHE, True)
 os.environ.setdefault("JAX_COMPILATION_CACHE_MAX_SIZE", str(CACHE_MAX_BYTES))
+if "IGNJAX_CACHE_DIR" not in os.environ and "IGNJAX_NO_CACHE" not in os.environ:
+    # ignjax's own cache (scene arrays: navigation grids, goal fields) the same way: one folder for the run,
+    # so the shipped scenes are gridded once, not once per process; removed when the run ends.
+    _IGNJAX_CACHE = tempfile.mkdtemp(prefix="ignjax-tests-cache-")
+    os.environ["IGNJAX_CACHE_DIR"] = _IGNJAX_CACHE
+    atexit.register(shutil.rmtree, _IGNJAX_CACHE, True)
 
 from ignjax.devices import configure_cpu_devices  # noqa: E402
 

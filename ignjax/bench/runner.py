@@ -62,6 +62,7 @@ import sys
 
 from ignjax.bench.scaling import SCALING_BATCH, bench_devices
 from ignjax.bench.timing import log
+from ignjax.cache import add_cache_arguments, apply_cache_arguments
 
 
 def main(argv=None) -> int:
@@ -80,7 +81,9 @@ def main(argv=None) -> int:
     p.add_argument("--pieces", action="store_true",
                    help="only where a decision step's time goes: microseconds per decision of each piece of the step "
                         "(ignjax.bench.pieces); with --quick the EIG and random agents")
+    add_cache_arguments(p)
     args = p.parse_args(argv)
+    apply_cache_arguments(args)
     # imported here, not at the top: the figures pull in jax, MuJoCo and the
     # simulator (about 5 s), which ``--help`` should not wait for
     import jax

@@ -43,6 +43,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from ignjax.cache import add_cache_arguments, apply_cache_arguments
 from ignjax.errors import ConfigError, IgnjaxError, SceneError
 
 
@@ -279,6 +280,7 @@ def cmd_episodes(args) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python -m ignjax.build", description=__doc__.split("\n\n")[0])
+    add_cache_arguments(p)  # before the command: python -m ignjax.build --no-compile-cache episodes ...
     sub = p.add_subparsers(dest="command", required=True)
 
     s = sub.add_parser("scenes", help="generate procedural houses as USD plus manifest.json")
@@ -336,6 +338,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
+        apply_cache_arguments(args)
         return int(args.func(args) or 0)
     except IgnjaxError as e:
         print(f"error: {e}", file=sys.stderr)

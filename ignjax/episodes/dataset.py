@@ -34,9 +34,9 @@ from ignjax.scenes import vocab
 from ignjax.scenes.bank import SceneBank
 from ignjax.scenes.buckets import plan_buckets
 from ignjax.scenes.compile import compile_scene
-from ignjax.scenes.geodesic import goal_fields
+from ignjax.scenes.derived import cached_goal_fields, cached_navgrid
 from ignjax.scenes.io.sources import load_scenes
-from ignjax.scenes.navgrid import GridConfig, build_navgrid
+from ignjax.scenes.navgrid import GridConfig
 from ignjax.sim.types import EpisodeSpec
 
 
@@ -215,7 +215,7 @@ def open_benchmark(path: str | os.PathLike, scenes_root: str | os.PathLike | Non
     if not scenes:
         raise EpisodeError(p, "episodes", "no episodes to run (the file, cut by limit / indices, is empty)")
     compiled = [compile_scene(s) for s in scenes]
-    host = SceneBank.from_compiled(compiled, [build_navgrid(c, grid) for c in compiled], arrays=False)
+    host = SceneBank.from_compiled(compiled, [cached_navgrid(c, grid) for c in compiled], arrays=False)
     episode_specs(records, host, p)  # every record checked before any table is built
     return BenchmarkScenes(p, records, host)
 
@@ -328,12 +328,13 @@ class BenchmarkScenes:
 def compute_fields(bank: SceneBank, pairs: list[tuple[int, int]], batch: int = 32, progress=None) -> jax.Array:
     """Geodesic fields (F, H, W) of (scene, instance) pairs on the bank's padded grid.
 
-    Each scene's targets go through :func:`~ignjax.scenes.geodesic.goal_fields`
-    (the batcher benchmark construction uses), ``batch`` at a time (a short
-    last batch is padded by repeating its last target, so each grid shape
-    compiles once), seed radius 1 m; the bank's padding is +inf. The fields
-    equal :func:`~ignjax.scenes.bank.target_fields` on the bank's grid, byte
-    for byte (checked on the shipped benchmark).
+    Each scene's targets go through
+    :func:`~ignjax.scenes.derived.cached_goal_fields` (the on-disk cache in
+    front of :func:`~ignjax.scenes.geodesic.goal_fields`, the batcher
+    benchmark construction uses), ``batch`` at a time, seed radius 1 m;
+    ``progress`` wraps the iteration over scenes. The bank's padding is
+    +inf. The fields equal :func:`~ignjax.scenes.bank.target_fields` on the
+    bank's grid, byte for byte (checked on the shipped benchmark).
     """
     H, W = bank.grid.navigable.shape[1:]
     out = np.full((len(pairs), H, W), np.inf, np.float32)
@@ -341,13 +342,12 @@ def compute_fields(bank: SceneBank, pairs: list[tuple[int, int]], batch: int = 3
     by_scene: dict[int, list[tuple[int, int]]] = {}
     for f, (s, i) in enumerate(pairs):
         by_scene.setdefault(s, []).append((f, i))
-    chunks = [(s, items[k:k + batch]) for s, items in by_scene.items() for k in range(0, len(items), batch)]
-    for s, chunk in (progress(chunks) if progress else chunks):
-        grid, scene = bank.navgrids[s], bank.scene(s)
-        padded = chunk + [chunk[-1]] * (batch - len(chunk))
-        fields = goal_fields(grid, [scene.instances[i].bbox for _, i in padded], [int(rooms[s, i]) for _, i in padded],
-                             1.0)
+    scenes = list(by_scene)
+    for s in (progress(scenes) if progress else scenes):
+        items, grid = by_scene[s], bank.navgrids[s]
+        fields = cached_goal_fields(bank.compiled[s], grid, [i for _, i in items], [int(rooms[s, i]) for _, i in items],
+                                    1.0, batch)
         h, w = grid.shape
-        for k, (f, _) in enumerate(chunk):
-            out[f, :h, :w] = fields[k]
+        for (f, _), field in zip(items, fields):
+            out[f, :h, :w] = field
     return jnp.asarray(out)

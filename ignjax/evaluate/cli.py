@@ -52,6 +52,7 @@ from pathlib import Path
 import numpy as np
 
 from ignjax.arrays import parse_assignment, parse_floats
+from ignjax.cache import add_cache_arguments, apply_cache_arguments
 from ignjax.devices import processes as PR
 from ignjax.errors import ConfigError, IgnjaxError
 from ignjax.fileio import atomic_write
@@ -96,6 +97,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--resume", action="store_true",
                    help="reuse the batches an interrupted run with the same settings left in OUT/parts")
     PR.add_arguments(p)
+    add_cache_arguments(p)
     g = p.add_argument_group("MLLM agents (" + ", ".join(sorted(LLM_AGENTS)) + "); settings also as --set llm.<key>=<value>"
                              " and --set views.<key>=<value>")
     g.add_argument("--llm-endpoint", action="append", default=[], metavar="URL",
@@ -214,6 +216,7 @@ def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser().parse_args(argv)
     try:
+        apply_cache_arguments(args)
         popts = PR.process_options(args)
         if popts.launch:  # every setting checked once, here, before any process starts
             from ignjax.devices.launch import launch

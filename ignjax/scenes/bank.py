@@ -31,10 +31,11 @@ from ignjax.arrays import pytree_dataclass
 from ignjax.errors import ConfigError
 from ignjax.scenes import vocab
 from ignjax.scenes.compile import CompileOptions, CompiledScene, compile_scene
+from ignjax.scenes.derived import cached_navgrid
 from ignjax.scenes.geodesic import geodesic_field, seeds_from_box
 from ignjax.scenes.graph import room_adjacency
 from ignjax.scenes.model import Scene
-from ignjax.scenes.navgrid import GridConfig, NavGrid, build_navgrid, check_reachable
+from ignjax.scenes.navgrid import GridConfig, NavGrid, check_reachable
 from ignjax.scenes.raygrid import RayGrid, ray_grid
 
 
@@ -171,7 +172,7 @@ class SceneBank:
                 :func:`~ignjax.scenes.navgrid.check_reachable`).
         """
         compiled = [compile_scene(s, compile_options) for s in scenes]
-        grids = [build_navgrid(c, config) for c in compiled]
+        grids = [cached_navgrid(c, config) for c in compiled]
         if check:
             for s, g in zip(scenes, grids):
                 check_reachable(s, g)

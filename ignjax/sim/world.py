@@ -4,7 +4,7 @@ bank for fast collision and free-space rays.
 
 The probe map (:func:`probe_map`, one bit per probe height on cells a
 :data:`FINE`-th of a navigation cell) is built on the host when a World is
-made (once per process for the same bank: :func:`remembered_probe_map`);
+made (once for the same bank, kept by the process and on disk: :func:`remembered_probe_map`);
 :func:`fine_at`, :func:`packed_at`, :func:`march_free` and :func:`probe_free`
 read it inside a rollout.
 """
@@ -20,6 +20,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ignjax.arrays import pytree_dataclass
+from ignjax.cache import code_digest, derived_store, digest
 from ignjax.errors import ConfigError
 from ignjax.scenes.bank import SceneBank
 from ignjax.sim import types as T
@@ -182,15 +183,21 @@ def _probe_map_key(bank: SceneBank, config: T.SimConfig) -> bytes:
 
 
 def remembered_probe_map(bank: SceneBank, config: T.SimConfig) -> jax.Array:
-    """:func:`probe_map`, computed once per process for the same inputs (the
-    last :data:`PROBE_MAPS_KEPT`, keyed by a digest of what it reads): a run
-    that builds several Worlds of one bank (a bucket, an MLLM agent's host
-    loop, a second run in a notebook) pays for it once. The same array as
-    :func:`probe_map` (it is that array)."""
+    """:func:`probe_map`, computed once for the same inputs: a process keeps
+    the last :data:`PROBE_MAPS_KEPT` (keyed by a digest of what it reads), so
+    a run that builds several Worlds of one bank (a bucket, an MLLM agent's
+    host loop, a second run in a notebook) pays for it once, and the on-disk
+    cache (:func:`ignjax.cache.derived_store`) keeps it for the next process.
+    The same array as :func:`probe_map` (it is that array)."""
     key = _probe_map_key(bank, config)
     hit = _PROBE_MAPS.get(key)
     if hit is None:  # kept on the host: a device holds only the Worlds' own copies
-        hit = _probe_bits(bank, config)
+        store = derived_store()
+        name = digest(code_digest(__name__), key)
+        got = None if store is None else store.get("probe_map", name)
+        hit = _probe_bits(bank, config) if got is None else got["bits"]
+        if store is not None and got is None:
+            store.put("probe_map", name, {"bits": hit})
         _PROBE_MAPS[key] = hit
         while len(_PROBE_MAPS) > PROBE_MAPS_KEPT:
             _PROBE_MAPS.popitem(last=False)

@@ -8,6 +8,7 @@ import sys
 import time
 from pathlib import Path
 
+from ignjax.cache import add_cache_arguments, apply_cache_arguments
 from ignjax.devices import processes as PR
 from ignjax.errors import ConfigError, IgnjaxError
 
@@ -36,6 +37,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--force", action="store_true", help="replace a folder that holds another run")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     PR.add_arguments(p)
+    add_cache_arguments(p)
     return p
 
 
@@ -74,6 +76,7 @@ def main(argv=None) -> int:
     from ignjax.config import resolve
 
     try:
+        apply_cache_arguments(args)  # before anything compiles, the configuration's checks included
         popts = PR.process_options(args)
         studies = parse_studies(args.study)
         # JAX's runtime joins before the configuration is resolved (its checks run JAX code); a launcher checks it

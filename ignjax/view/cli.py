@@ -19,6 +19,7 @@ import sys
 import time
 from pathlib import Path
 
+from ignjax.cache import add_cache_arguments, apply_cache_arguments
 from ignjax.errors import ConfigError, IgnjaxError
 
 
@@ -39,12 +40,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--title", help="page title (default: the sweep's run name or the folder's name)")
     p.add_argument("--gif", metavar="EPISODE_ID", help="export this episode as an animation instead of the page")
     p.add_argument("--fps", type=float, default=1.5, help="frames (planner steps) per second of --gif (default 1.5)")
+    add_cache_arguments(p)
     return p
 
 
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     try:
+        apply_cache_arguments(args)
         return run(args)
     except IgnjaxError as e:
         print(f"error: {e}", file=sys.stderr)

@@ -16,6 +16,7 @@ directory without a manifest           every supported file in it (sorted)
 from __future__ import annotations
 
 import gzip
+import importlib.metadata
 import json
 import os
 from pathlib import Path
@@ -24,7 +25,10 @@ from types import MappingProxyType
 from ignjax.errors import SceneError, call_recording_warnings, warn_again
 from ignjax.scenes.io.formats import JSON_SUFFIXES, MESH_SUFFIXES, SIDECAR_SUFFIX, USD_SUFFIXES
 from ignjax.scenes.io.manifest import read_manifest
+from ignjax.scenes.io.remembered import read_remembered
 from ignjax.scenes.model import Scene, scene_from_dict
+
+_USD_VERSION = importlib.metadata.version("usd-core")
 
 
 
@@ -144,9 +148,9 @@ def scene_sources(paths, map_=map) -> list[tuple[object, Path]]:
 
 
 def _read_usd(p: Path) -> list[Scene]:
-    from ignjax.scenes.io.usd.load import load_usd
+    from ignjax.scenes.io.usd.load import read_usd
 
-    return [load_usd(p)]
+    return [read_remembered(p, "usd", lambda: read_usd(p), _USD_VERSION)]
 
 
 def _read_mesh(p: Path) -> list[Scene]:

@@ -414,11 +414,24 @@ def load_usd(path: str | os.PathLike, *, scene_id: str | None = None, correct_la
             imported; many become one summary), an invalid ``defaultPrim``,
             skipped prims, other messages USD issued during the import.
     """
+    return read_usd(path, scene_id=scene_id, correct_layer_units=correct_layer_units)[0]
+
+
+def read_usd(path: str | os.PathLike, *, scene_id: str | None = None,
+             correct_layer_units: bool = True) -> tuple[Scene, tuple[Path, ...]]:
+    """:func:`load_usd`, and the other files the stage was composed from (its
+    used layers other than the root, outside the root file: sublayers,
+    references, payloads), for a cache that must know what a scene was read
+    from (:mod:`ignjax.scenes.io.remembered`)."""
     importer, reported = None, []
     try:
         with usd_diagnostics() as reported:
             importer = _Importer(Path(path), scene_id, correct_layer_units)
-            return importer.run()
+            scene = importer.run()
+            root = importer.stage.GetRootLayer()
+            files = tuple(sorted({Path(layer.realPath) for layer in importer.stage.GetUsedLayers()
+                                  if layer is not root and layer.realPath and "[" not in layer.realPath}))
+            return scene, files
     finally:
         if importer is not None:
             warn_usd_messages(importer.spath, reported, importer.composition_texts)
