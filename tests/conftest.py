@@ -61,6 +61,19 @@ from ignjax.devices import configure_cpu_devices  # noqa: E402
 
 configure_cpu_devices(2)
 
+if os.environ.get("IGNJAX_TEST_COMPILE_LOG"):
+    # Where the suite's compile time goes: each program this process compiles or loads from the cache, one line
+    # "test <tab> program <tab> seconds" in IGNJAX_TEST_COMPILE_LOG.<pid> (a diagnostic; off unless set).
+    import jax  # noqa: E402
+
+    def _log_compile(event, duration, **kw):
+        if event == "/jax/core/compile/backend_compile_duration":
+            test = os.environ.get("PYTEST_CURRENT_TEST", "-").rsplit(" ", 1)[0]
+            with open(f"{os.environ['IGNJAX_TEST_COMPILE_LOG']}.{os.getpid()}", "a") as fh:
+                fh.write(f"{test}\t{kw.get('fun_name', '?')}\t{duration:.3f}\n")
+
+    jax.monitoring.register_event_duration_secs_listener(_log_compile)
+
 ROOT = Path(__file__).resolve().parents[1]
 IN_CI = os.environ.get("CI", "").strip().lower() not in ("", "0", "false", "no")
 """``CI`` set to anything but empty/0/false/no: skips are failures."""
