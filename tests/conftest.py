@@ -6,10 +6,10 @@ skip with the reason when it is absent. The core suite never needs it.
 The session runs with two CPU devices (``ignjax.devices.configure_cpu_devices``,
 set here before JAX starts; ``IGNJAX_CPU_DEVICES`` overrides the count), so
 rollouts are sharded over two devices unless a test says otherwise. The
-run shares one JAX persistent compilation cache (a temporary folder, or
-``JAX_COMPILATION_CACHE_DIR`` when set) among its xdist workers and the
-processes its tests start, and one ignjax cache folder (``IGNJAX_CACHE_DIR``:
-scene grids and goal fields); outputs never depend on whether they were hit.
+run shares one JAX persistent compilation cache and one ignjax cache folder
+(scene files, grids, goal fields, probe maps) among its xdist workers and the
+processes its tests start, kept between runs (see :func:`_suite_cache_folder`);
+outputs never depend on whether they were hit.
 
 ``two_room_scene``: a small hand-built scene (living room + bedroom, one
 door) with known instances, for tests that need exact expectations.
@@ -39,23 +39,38 @@ import pytest
 os.environ.setdefault("MUJOCO_GL", "egl")
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 CACHE_MAX_BYTES = 4 << 30
-"""Size bound of the session's persistent compilation cache (oldest entries evicted first)."""
-if "JAX_COMPILATION_CACHE_DIR" not in os.environ:
-    # One persistent compilation cache for the whole run, set before JAX starts: the xdist workers and every
-    # process a test starts inherit it, so a program compiled in one is loaded, not compiled again, by the others
-    # (and after jax.clear_caches below). A size bound turns on JAX's file lock around every read and write, so
-    # processes never read an entry another is still writing. Removed when the run ends. A folder of your own in
-    # JAX_COMPILATION_CACHE_DIR is used instead and kept, so a second run loads what the first compiled.
-    _CACHE = tempfile.mkdtemp(prefix="ignjax-tests-jax-cache-")
-    os.environ["JAX_COMPILATION_CACHE_DIR"] = _CACHE
-    atexit.register(shutil.rmtree, _CACHE, True)
+"""Size bound of the suite's persistent compilation cache (oldest entries evicted first)."""
+
+
+def _suite_cache_folder() -> str:
+    """Where the suite keeps compiled programs and scene arrays between runs:
+    ``IGNJAX_TEST_CACHE`` (a folder, or ``fresh`` for a throwaway folder
+    removed when the run ends), by default ``tests/`` in the per-user ignjax
+    cache folder, so a second run on the machine loads the programs the first
+    compiled (as the vLLM environment, built once per machine)."""
+    where = os.environ.get("IGNJAX_TEST_CACHE", "").strip()
+    if where == "fresh":
+        folder = tempfile.mkdtemp(prefix="ignjax-tests-cache-")
+        atexit.register(shutil.rmtree, folder, True)
+        return folder
+    if where:
+        return where
+    import platformdirs
+
+    return str(Path(platformdirs.user_cache_dir("ignjax", appauthor=False)) / "tests")
+
+
+if "JAX_COMPILATION_CACHE_DIR" not in os.environ or "IGNJAX_CACHE_DIR" not in os.environ:
+    # Set before JAX starts: the xdist workers and every process a test starts inherit them, so a program
+    # compiled in one is loaded, not compiled again, by the others (and after jax.clear_caches below) and by
+    # later runs; likewise the shipped scenes are gridded once. A size bound turns on JAX's file lock around
+    # every read and write, so processes never read an entry another is still writing. Folders of your own in
+    # JAX_COMPILATION_CACHE_DIR / IGNJAX_CACHE_DIR are used instead. Outputs never depend on a hit.
+    _SUITE_CACHE = _suite_cache_folder()
+    os.environ.setdefault("JAX_COMPILATION_CACHE_DIR", os.path.join(_SUITE_CACHE, "jax"))
+    if "IGNJAX_NO_CACHE" not in os.environ:
+        os.environ.setdefault("IGNJAX_CACHE_DIR", os.path.join(_SUITE_CACHE, "ignjax"))
 os.environ.setdefault("JAX_COMPILATION_CACHE_MAX_SIZE", str(CACHE_MAX_BYTES))
-if "IGNJAX_CACHE_DIR" not in os.environ and "IGNJAX_NO_CACHE" not in os.environ:
-    # ignjax's own cache (scene arrays: navigation grids, goal fields) the same way: one folder for the run,
-    # so the shipped scenes are gridded once, not once per process; removed when the run ends.
-    _IGNJAX_CACHE = tempfile.mkdtemp(prefix="ignjax-tests-cache-")
-    os.environ["IGNJAX_CACHE_DIR"] = _IGNJAX_CACHE
-    atexit.register(shutil.rmtree, _IGNJAX_CACHE, True)
 
 from ignjax.devices import configure_cpu_devices  # noqa: E402
 

@@ -16,13 +16,13 @@ from __future__ import annotations
 
 import hashlib
 import json
+import warnings
 from pathlib import Path
 from typing import Callable
 
 import numpy as np
 
 from ignjax.cache import code_digest, derived_store, digest
-from ignjax.errors import call_recording_warnings, warn_again
 from ignjax.scenes.model import Scene, scene_from_dict, scene_to_json
 
 
@@ -57,8 +57,11 @@ def read_remembered(path: Path, kind: str, read: Callable[[], tuple[Scene, tuple
         deps = json.loads(got["deps"].tobytes().decode())
         if all(_file_digest(Path(f)) == h for f, h in deps.items()):
             return scene_from_dict(json.loads(got["scene"].tobytes().decode()), str(path))
-    (scene, used), caught = call_recording_warnings(read)
-    warn_again(caught)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        scene, used = read()
+    for w in caught:  # given again where they were raised, as if not caught
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno, source=w.source)
     text = scene_to_json(scene)
     if not caught and scene_to_json(scene_from_dict(json.loads(text), str(path))) == text:
         deps = {str(f): _file_digest(f) for f in used}
