@@ -331,7 +331,8 @@ def compute_fields(bank: SceneBank, pairs: list[tuple[int, int]], batch: int = 3
     Each scene's targets go through
     :func:`~ignjax.scenes.derived.cached_goal_fields` (the on-disk cache in
     front of :func:`~ignjax.scenes.geodesic.goal_fields`, the batcher
-    benchmark construction uses), ``batch`` at a time, seed radius 1 m;
+    benchmark construction uses), ``batch`` at a time, seed radius 1 m, on
+    the bank's padded grid (one compiled program for every scene);
     ``progress`` wraps the iteration over scenes. The bank's padding is
     +inf. The fields equal :func:`~ignjax.scenes.bank.target_fields` on the
     bank's grid, byte for byte (checked on the shipped benchmark).
@@ -346,7 +347,7 @@ def compute_fields(bank: SceneBank, pairs: list[tuple[int, int]], batch: int = 3
     for s in (progress(scenes) if progress else scenes):
         items, grid = by_scene[s], bank.navgrids[s]
         fields = cached_goal_fields(bank.compiled[s], grid, [i for _, i in items], [int(rooms[s, i]) for _, i in items],
-                                    1.0, batch)
+                                    1.0, batch, (H, W))
         h, w = grid.shape
         for (f, _), field in zip(items, fields):
             out[f, :h, :w] = field

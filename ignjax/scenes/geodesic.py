@@ -249,11 +249,13 @@ _object_fields = jax.jit(jax.vmap(_object_field, in_axes=(None, None, None, None
                          static_argnums=(3, 8))
 
 
-def goal_fields(grid: NavGrid, boxes: list, room_indices: list[int], seed_radius: float) -> np.ndarray:
+def goal_fields(grid: NavGrid, boxes: list, room_indices: list[int], seed_radius: float,
+                shape: tuple[int, int] | None = None) -> np.ndarray:
     """Geodesic fields (K, H, W) float32 to K objects on one grid (vmapped).
 
-    The grid is padded to multiples of :data:`GRID_PAD` cells (not
-    navigable) so scenes of similar size share one compiled program; the
+    The grid is padded (not navigable) to ``shape`` when given (a bank's
+    padded grid: one compiled program for all its scenes), else to multiples
+    of :data:`GRID_PAD` cells, so scenes of similar size share one; the
     padding does not change a field (it is never navigable). Benchmark
     construction calls it with a scene's candidates, the episode loader
     (:func:`ignjax.episodes.dataset.compute_fields`) with its targets.
@@ -270,7 +272,7 @@ def goal_fields(grid: NavGrid, boxes: list, room_indices: list[int], seed_radius
     if not boxes:
         return np.zeros((0,) + tuple(grid.shape), np.float32)
     H, W = grid.shape
-    Hp, Wp = -(-H // GRID_PAD) * GRID_PAD, -(-W // GRID_PAD) * GRID_PAD
+    Hp, Wp = shape if shape is not None else (-(-H // GRID_PAD) * GRID_PAD, -(-W // GRID_PAD) * GRID_PAD)
     nav = np.zeros((Hp, Wp), bool)
     nav[:H, :W] = grid.navigable
     room = np.full((Hp, Wp), -1, np.int32)

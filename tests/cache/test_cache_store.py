@@ -107,6 +107,10 @@ def test_grid_and_fields_are_the_same_bytes_cold_warm_and_off(two_room_scene, mo
     targets = [i for i, inst in enumerate(two_room_scene.instances) if not inst.structural][:3]
     rooms = [reference.room_index(two_room_scene.instances[i].room) for i in targets]
     direct = goal_fields(reference, [two_room_scene.instances[i].bbox for i in targets], rooms, 1.0)
+    # on a larger padded grid (a bank's, shared by all its scenes): the same bytes, so one entry serves both
+    H, W = reference.shape
+    wide = goal_fields(reference, [two_room_scene.instances[i].bbox for i in targets], rooms, 1.0, (H + 45, W + 70))
+    assert wide.tobytes() == direct.tobytes()
     monkeypatch.setenv("IGNJAX_NO_CACHE", "1")
     _same_grid(cached_navgrid(compiled), reference)
     monkeypatch.delenv("IGNJAX_NO_CACHE")
