@@ -75,13 +75,21 @@ def _sources(module) -> list[bytes]:
     return [str(p.relative_to(root)).encode() + b"\0" + p.read_bytes() for p in sorted(root.rglob("*.py"))]
 
 
-def _checksum(arrays: dict[str, np.ndarray]) -> np.ndarray:
-    h = hashlib.blake2b(digest_size=32)
-    for name in sorted(arrays):
-        a = np.ascontiguousarray(arrays[name])
-        h.update(f"{name}|{a.dtype.str}|{a.shape}|".encode())
+def array_digest(*parts, size: int = 20) -> bytes:
+    """blake2b digest of arrays (or anything ``np.asarray`` takes), each with
+    its dtype and shape: equal exactly when every part has the same dtype,
+    shape and bytes."""
+    h = hashlib.blake2b(digest_size=size)
+    for part in parts:
+        a = np.ascontiguousarray(np.asarray(part))
+        h.update(f"{a.dtype.str}|{a.shape}|".encode())
         h.update(a.tobytes())
-    return np.frombuffer(h.digest(), np.uint8)
+    return h.digest()
+
+
+def _checksum(arrays: dict[str, np.ndarray]) -> np.ndarray:
+    names = sorted(arrays)
+    return np.frombuffer(array_digest(np.array(names), *(arrays[n] for n in names), size=32), np.uint8)
 
 
 class ArrayStore:
@@ -97,6 +105,7 @@ class ArrayStore:
         self.root = Path(root)
         self.bound_bytes = int(bound_bytes)
         self._unwritable = False
+        self._bytes: int | None = None  # the store's size as this process last counted it, plus its writes since
 
     def path(self, kind: str, key: str) -> Path:
         return self.root / kind / f"{key}.npz"
@@ -132,17 +141,22 @@ class ArrayStore:
         arrays = {n: np.asarray(a) for n, a in arrays.items()}
         buf = io.BytesIO()
         np.savez(buf, **arrays, **{_CHECKSUM: _checksum(arrays), _FORMAT: np.int64(FORMAT)})
+        data = buf.getvalue()
         try:
-            atomic_write(self.path(kind, key), buf.getvalue())
+            atomic_write(self.path(kind, key), data)
         except OSError as e:
             self._unwritable = True
             warnings.warn(f"ignjax cache: cannot write under {self.root} ({e.strerror or e}); going on without it",
                           CacheWarning, stacklevel=2)
             return False
-        self._evict()
+        # the folder is listed once, then again only when the count passes the bound (not after every write)
+        self._bytes = self._evict() if self._bytes is None else self._bytes + len(data)
+        if self._bytes > self.bound_bytes:
+            self._bytes = self._evict()
         return True
 
-    def _evict(self) -> None:
+    def _evict(self) -> int:
+        """Delete the least recently used entries past the bound; the bytes left."""
         entries = []
         for p in self.root.glob("*/*.npz"):
             try:
@@ -156,6 +170,7 @@ class ArrayStore:
                 break
             p.unlink(missing_ok=True)
             total -= size
+        return total
 
 
 _STORES: dict[Path, ArrayStore] = {}
@@ -173,4 +188,4 @@ def derived_store() -> ArrayStore | None:
     return _STORES[root]
 
 
-__all__ = ["ArrayStore", "CacheWarning", "DEFAULT_BOUND_BYTES", "FORMAT", "code_digest", "derived_store", "digest"]
+__all__ = ["ArrayStore", "CacheWarning", "array_digest", "DEFAULT_BOUND_BYTES", "FORMAT", "code_digest", "derived_store", "digest"]

@@ -11,7 +11,6 @@ read it inside a rollout.
 
 from __future__ import annotations
 
-import hashlib
 import math
 from collections import OrderedDict
 
@@ -20,7 +19,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ignjax.arrays import pytree_dataclass
-from ignjax.cache import code_digest, derived_store, digest
+from ignjax.cache import array_digest, code_digest, derived_store, digest
 from ignjax.errors import ConfigError
 from ignjax.scenes.bank import SceneBank
 from ignjax.sim import types as T
@@ -171,15 +170,9 @@ def _probe_map_key(bank: SceneBank, config: T.SimConfig) -> bytes:
     """A digest of everything :func:`probe_map` reads: the bank's ray grid
     and navigation-grid geometry and the probe heights."""
     g, r = bank.grid, bank.rays
-    h = hashlib.blake2b(digest_size=20)
-    parts = (np.asarray(g.navigable).shape, g.origin, g.resolution, r.voxcode, r.seg_start, r.seg_count, r.seg_prims,
-             r.approx, r.prims, r.origin, r.dims, r.resolution, r.slice_height, r.slices_per_band,
-             probe_heights(config))
-    for part in parts:
-        a = np.ascontiguousarray(np.asarray(part))
-        h.update(f"{a.dtype}{a.shape}".encode())
-        h.update(a.tobytes())
-    return h.digest()
+    return array_digest(np.asarray(g.navigable).shape, g.origin, g.resolution, r.voxcode, r.seg_start, r.seg_count,
+                        r.seg_prims, r.approx, r.prims, r.origin, r.dims, r.resolution, r.slice_height,
+                        r.slices_per_band, probe_heights(config))
 
 
 def remembered_probe_map(bank: SceneBank, config: T.SimConfig) -> jax.Array:
