@@ -24,8 +24,10 @@ import numpy as np
 from ignjax.cache.folder import cache_root
 from ignjax.fileio import atomic_write
 
-FORMAT = 1
-"""Version of the entry layout; entries of another version are misses."""
+FORMAT = 2
+"""Version of the entry layout (2: checksums by :func:`array_digest`). It is
+part of every key made with :func:`code_digest`, so entries of another
+version are never looked up; one read anyway is a quiet miss."""
 
 DEFAULT_BOUND_BYTES = 4 << 30
 """Size bound of the derived-array store (oldest entries evicted first)."""
@@ -123,7 +125,9 @@ class ArrayStore:
                           stacklevel=2)
             return None
         check, fmt = arrays.pop(_CHECKSUM, None), arrays.pop(_FORMAT, None)
-        if fmt is None or int(fmt) != FORMAT or check is None or not np.array_equal(check, _checksum(arrays)):
+        if fmt is not None and int(fmt) != FORMAT:
+            return None  # written by another version: not damaged, computed again and replaced
+        if fmt is None or check is None or not np.array_equal(check, _checksum(arrays)):
             warnings.warn(f"ignjax cache: {p} does not match its checksum; computing it again", CacheWarning,
                           stacklevel=2)
             return None
