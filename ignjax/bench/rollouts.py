@@ -54,6 +54,21 @@ def bench_steps(es, world, agents, sizes) -> tuple[dict, float]:
     return out, compile_s
 
 
+def in_loop_sweep(es, world, K: int, E: int = 500):
+    """The EIG agent's in-the-loop sweep as a call: K cost vectors (the
+    locked costs scaled by 0.25 .. 8, geometrically) x E episodes (the
+    episode set repeated to E) in one vmapped rollout, waited for."""
+    agent = get_agent("eig")
+    base = agent.default_params()
+    scales = np.geomspace(0.25, 8.0, K)
+    params = jax.tree.map(lambda x: jnp.broadcast_to(x, (K,) + jnp.shape(x)), base)
+    params = dataclasses.replace(params, costs=jnp.asarray(scales[:, None] * np.asarray(LOCKED_COSTS), jnp.float32))
+    idx = np.arange(E) % len(es)
+    specs = jax.tree.map(lambda a: a[idx], es.specs)
+    keys = episode_keys(0, np.arange(E))
+    return lambda: jax.block_until_ready(rollout_sweep(world, specs, agent, params, keys))
+
+
 def bench_studies(es, world, quick: bool) -> dict:
     """Offline WSR of 10^6 cost vectors x 500 episodes x 5 agents, and the
     EIG agent's in-the-loop sweep (K cost vectors x 500 episodes in one
@@ -69,16 +84,8 @@ def bench_studies(es, world, quick: bool) -> dict:
     offline_wsr(success, nq, valid, costs)
     offline_s = time.perf_counter() - t
     K = 16 if quick else 256
-    agent = get_agent("eig")
-    base = agent.default_params()
-    scales = np.geomspace(0.25, 8.0, K)
-    params = jax.tree.map(lambda x: jnp.broadcast_to(x, (K,) + jnp.shape(x)), base)
-    params = dataclasses.replace(params, costs=jnp.asarray(scales[:, None] * np.asarray(LOCKED_COSTS), jnp.float32))
     n = min(len(es), E)
-    idx = np.arange(E) % len(es)
-    specs = jax.tree.map(lambda a: a[idx], es.specs)
-    keys = episode_keys(0, np.arange(E))
-    sweep = lambda: jax.block_until_ready(rollout_sweep(world, specs, agent, params, keys))  # noqa: E731
+    sweep = in_loop_sweep(es, world, K, E)
     in_loop_s = timed(sweep)
     run_s = timed(sweep)
     log(f"  offline WSR 1e6 cost vectors x {E} episodes x {A} agents: {offline_s:.2f} s")

@@ -38,6 +38,12 @@ process, on the same inputs:
   observation, each run as a program of its own on one device's share of
   the B = 4096 rollouts, beside that share's fused rollout (``whole``).
 * **compile_s** - first call of the EIG agent's rollout at B = 256.
+* **time_to_result** - what a researcher waits for a result
+  (:mod:`ignjax.bench.time_to_result`): ``evaluate --agent eig`` on the
+  500 episodes, ``sweep --study eval --quick`` and the in-the-loop sweep of
+  16 cost vectors x 500 episodes, each in a fresh process on an empty cache
+  folder (cold) and again on that folder (warm), split into load, compile
+  and run, with the number of programs compiled or loaded from the cache.
 * **studies** - offline WSR of 10^6 cost vectors x 500 episodes, and the
   in-the-loop sweep (the EIG agent under K cost vectors x 500 episodes in
   one vmapped call; ``--quick`` uses K = 16): ``in_loop_s`` is the first
@@ -46,6 +52,7 @@ process, on the same inputs:
 ``--json``: the last line of stdout is one JSON object with every figure.
 ``--llm``: only the MLLM host loop's figures (:mod:`ignjax.bench.llm`).
 ``--pieces``: only the ``pieces`` block.
+``--time-to-result``: only the ``time_to_result`` block.
 ``--scaling``: only how cost grows (:mod:`ignjax.bench.scaling`): steps/s and
 memory against batch size, scenes in the bank, devices and cost vectors, as
 ``scaling.png`` and ``scaling.json`` in ``--out``.
@@ -81,6 +88,9 @@ def main(argv=None) -> int:
     p.add_argument("--pieces", action="store_true",
                    help="only where a decision step's time goes: microseconds per decision of each piece of the step "
                         "(ignjax.bench.pieces); with --quick the EIG and random agents")
+    p.add_argument("--time-to-result", action="store_true",
+                   help="only the time_to_result block: evaluate, a quick sweep and the in-the-loop sweep, each cold "
+                        "and warm in fresh processes (ignjax.bench.time_to_result)")
     add_cache_arguments(p)
     args = p.parse_args(argv)
     apply_cache_arguments(args)
@@ -119,11 +129,16 @@ def main(argv=None) -> int:
         log(f"  wrote {res['scaling']['files']['png']}")
         print(json.dumps(res, sort_keys=True) if args.json else json.dumps(res, indent=2, sort_keys=True))
         return 0
+    if args.time_to_result:
+        res["time_to_result"] = _time_to_result(args.episodes)
+        print(json.dumps(res, sort_keys=True) if args.json else json.dumps(res, indent=2, sort_keys=True))
+        return 0
     if args.pieces:
         es = load_benchmark(args.episodes or SHIPPED_BENCHMARK)
         res["pieces"] = _pieces(es, make_world(es), ("random", "eig") if args.quick else AGENTS)
         print(json.dumps(res, sort_keys=True) if args.json else json.dumps(res, indent=2, sort_keys=True))
         return 0
+    res["time_to_result"] = _time_to_result(args.episodes)  # first: fresh processes, this one still small
     log("rays ...")
     res.update(bench_rays(args.quick))
     r = res["rays_per_s"]
@@ -156,6 +171,15 @@ def main(argv=None) -> int:
     else:
         print(json.dumps(res, indent=2, sort_keys=True))
     return 0
+
+
+def _time_to_result(episodes) -> dict:
+    """:func:`ignjax.bench.time_to_result.bench_time_to_result`, with its progress lines."""
+    from ignjax.bench.time_to_result import bench_time_to_result
+    from ignjax.sweep.stages import SHIPPED_BENCHMARK
+
+    log("time to result (fresh processes; cold = empty cache folder, then warm) ...")
+    return bench_time_to_result(str(episodes or SHIPPED_BENCHMARK), log=log)
 
 
 def _pieces(es, world, agents) -> dict:

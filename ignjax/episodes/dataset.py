@@ -27,6 +27,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ignjax.cache.clock import in_phase
 from ignjax.episodes.difficulty import BIN_INDEX
 from ignjax.episodes.schema import read_episodes
 from ignjax.errors import ConfigError, EpisodeError, IgnjaxError
@@ -169,6 +170,7 @@ def load_benchmark(path: str | os.PathLike, scenes_root: str | os.PathLike | Non
     return bs.episode_set(np.arange(len(bs.records)), field_batch, progress)
 
 
+@in_phase("load")
 def open_benchmark(path: str | os.PathLike, scenes_root: str | os.PathLike | None = None,
                    grid: GridConfig = GridConfig(), limit: int | None = None, indices=None) -> "BenchmarkScenes":
     """Read an episode file, load and compile its scenes on the host and check
@@ -298,6 +300,7 @@ class BenchmarkScenes:
         return BenchmarkScenes(self.path, records,
                                SceneBank.from_compiled(compiled, grids, categories=h.categories, arrays=False))
 
+    @in_phase("load")
     def episode_set(self, positions, field_batch: int = 32, progress=None) -> EpisodeSet:
         """The :class:`EpisodeSet` of the records at ``positions`` (in that
         order): a bank of only the scenes they use (in the host bank's order,

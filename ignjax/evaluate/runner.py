@@ -16,6 +16,7 @@ import numpy as np
 
 from dataclasses import dataclass
 
+from ignjax.cache.clock import in_phase
 from ignjax.agents import Agent, get_agent
 from ignjax.episodes.dataset import BenchmarkScenes, EpisodeSet
 from ignjax.sim.rollout import episode_keys, pad_batch, rollout
@@ -26,6 +27,7 @@ from ignjax.protocol import N_VIEWS
 from ignjax.sim.types import SimConfig
 
 
+@in_phase("load")
 def make_world(es: EpisodeSet, config: SimConfig = SimConfig()) -> World:
     """The simulator world of an episode set (bank + goal fields)."""
     return World(es.bank, es.fields, config)

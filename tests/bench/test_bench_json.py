@@ -31,7 +31,7 @@ STUDY_KEYS = {"offline_wsr_1e6_x_500_s", "in_loop_vectors", "in_loop_episodes", 
               "in_loop_episodes_per_s"}
 TOP_KEYS = {"device", "quick", "n_rays", "ngeom", "rays_per_s", "ray_agreement", "ray_agreement_depth_march",
             "scene_compile_s", "speedup_vs_mjx", "speedup_vs_multiray", "probe_ray_agreement", "rollout_parts",
-            "steps_per_s", "compile_s", "studies", "limit", "pieces", "scaling"}
+            "steps_per_s", "compile_s", "studies", "limit", "pieces", "scaling", "time_to_result"}
 SIZES = ("256", "1024", "4096")
 
 
@@ -79,10 +79,24 @@ def check_record(res: dict) -> None:
         assert _positive(a["fraction"]) and _positive(a["work"]["gather_world"]), (name, a)
     assert all(_positive(v) for v in lim["rates"].values()), lim["rates"]
     check_pieces(res["pieces"], ("random", "eig"), decisions_within=PIECES_DECISIONS_WITHIN)
+    check_time_to_result(res["time_to_result"])
     s = res["studies"]
     assert set(s) == STUDY_KEYS
     assert s["in_loop_vectors"] == 16 and s["in_loop_episodes"] == 500  # --quick: K = 16
     assert all(_positive(v) for v in s.values()), s
+
+
+def check_time_to_result(block) -> None:
+    """Each task cold and warm: a split that adds up, every program compiled cold and loaded warm, the same bytes."""
+    assert set(block) == {"evaluate", "sweep_eval_quick", "in_loop"}
+    for name, runs in block.items():
+        for state in ("cold", "warm"):
+            r = runs[state]
+            assert all(_positive(r[k]) for k in ("total_s", "load_s", "compile_s", "run_s")), (name, r)
+            assert math.isclose(r["load_s"] + r["compile_s"] + r["run_s"], r["total_s"]), (name, r)
+            assert r["programs"] == r["compiled"] + r["cache_hits"] > 0, (name, r)
+        assert runs["cold"]["cache_hits"] == 0 and runs["warm"]["compiled"] == 0, (name, runs)
+        assert runs.get("same_outputs", True) is True, name
 
 
 PIECES_DECISIONS_WITHIN = 0.01

@@ -17,36 +17,34 @@ def _env(cache: Path) -> dict:
     return dict(env, IGNJAX_CACHE_DIR=str(cache), PYTHONHASHSEED="0")
 
 
-def _sweep(small_benchmark, out: Path, env: dict, *extra: str) -> subprocess.CompletedProcess:
-    args = [sys.executable, "-m", "ignjax.sweep", "--study", "eval", "--quick", "--quiet", "--out", str(out),
-            "--set", f"benchmark.episodes='{small_benchmark['path']}'", "--set", "eval.agents=['random']",
-            "--set", "eval.batch=8", "--set", "analysis.trajectories=1", *extra]
-    return subprocess.run(args, cwd=REPO, env=env, capture_output=True, text=True, timeout=600)
-
-
-def _files(folder: Path) -> dict:
-    return {p.relative_to(folder): p.read_bytes() for p in sorted(folder.rglob("*"))
-            if p.is_file() and "checkpoints" not in p.parts}
+def _sweep_args(small_benchmark) -> list[str]:
+    return ["--study", "eval", "--quick", "--quiet", "--set", f"benchmark.episodes='{small_benchmark['path']}'",
+            "--set", "eval.agents=['random']", "--set", "eval.batch=8", "--set", "analysis.trajectories=1"]
 
 
 def test_main_job_twice_cold_then_warm_writes_the_same_bytes(small_benchmark, tmp_path):
-    """Two fresh processes on an empty cache folder: the first compiles and
-    fills it, the second loads its programs and scene arrays (no new
-    compilation entry) and writes every output file byte for byte the same."""
-    cache, env = tmp_path / "cache", _env(tmp_path / "cache")
-    cold = _sweep(small_benchmark, tmp_path / "cold", env)
-    assert cold.returncode == 0, cold.stderr[-3000:]
-    entries = {p.name for p in (cache / "jax").iterdir()}
-    assert len(entries) > 10, "the first run wrote no compiled programs into <cache>/jax"
+    """Two fresh processes on an empty cache folder (the bench's
+    ``time_to_result`` measurement): the first compiles and fills it, the
+    second loads every program from it (no new compilation entry) and its
+    scene arrays, and writes every output file byte for byte the same; the
+    block's split adds up."""
+    from ignjax.bench.time_to_result import cold_and_warm
+
+    cache = tmp_path / "cache"
+    seen: dict = {}  # the compiled entries after the cold run (the log line comes after each run)
+    runs = cold_and_warm("sweep", _sweep_args(small_benchmark), tmp_path, env=_env(cache),
+                         log=lambda line: seen.setdefault("entries", {p.name for p in (cache / "jax").iterdir()}))
+    cold, warm = runs["cold"], runs["warm"]
+    assert len(seen["entries"]) > 10, "the first run wrote no compiled programs into <cache>/jax"
     assert list((cache / "derived" / "navgrid").glob("*.npz")) and list((cache / "derived" / "goal_field").glob("*.npz"))
-    warm = _sweep(small_benchmark, tmp_path / "warm", env)
-    assert warm.returncode == 0, warm.stderr[-3000:]
-    added = {p.name for p in (cache / "jax").iterdir()} - entries
+    added = {p.name for p in (cache / "jax").iterdir()} - seen["entries"]
     assert not [n for n in added if n.startswith("jit_")], f"the second run compiled again: {sorted(added)[:5]}"
-    a, b = _files(tmp_path / "cold"), _files(tmp_path / "warm")
-    assert a.keys() == b.keys() and len(a) > 5
-    for name in a:
-        assert a[name] == b[name], name
+    assert runs["same_outputs"] is True
+    assert cold["compiled"] == cold["programs"] > 10 and cold["cache_hits"] == 0
+    assert warm["compiled"] == 0 and warm["cache_hits"] == warm["programs"] > 10
+    for r in (cold, warm):
+        assert r["load_s"] > 0 and r["compile_s"] > 0 and r["run_s"] > 0
+        assert abs(r["load_s"] + r["compile_s"] + r["run_s"] - r["total_s"]) < 1e-6
 
 
 def test_unwritable_cache_folder_is_one_warning_and_the_command_goes_on(small_benchmark, tmp_path):
