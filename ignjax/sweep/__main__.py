@@ -2,7 +2,11 @@
 
 import sys
 
-from ignjax.devices import configure_cpu_devices
+from ignjax.scenes.viz import headless_gl
+
+headless_gl()  # before anything imports mujoco: headless EGL where it is installed and MUJOCO_GL is unset
+
+from ignjax.devices import configure_cpu_devices  # noqa: E402
 
 configure_cpu_devices()  # before JAX starts: one CPU device per core (IGNJAX_CPU_DEVICES overrides)
 

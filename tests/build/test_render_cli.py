@@ -55,10 +55,28 @@ def rendered(two_room_scene, gl_env, tmp_path_factory):
     src = root / "two_rooms.usda"
     save_usd(two_room_scene, src)
     out = root / "out"
+    env = gl_env
+    if env["MUJOCO_GL"] == "egl":  # the command selects headless EGL itself: no variable set, no display
+        env = {k: v for k, v in env.items() if k not in ("MUJOCO_GL", "PYOPENGL_PLATFORM", "DISPLAY", "WAYLAND_DISPLAY")}
     proc = subprocess.run([sys.executable, "-m", "ignjax.build", "render", str(src), "--out", str(out), "--size", str(SIZE)],
-                          env=gl_env, capture_output=True, text=True, timeout=600)
+                          env=env, capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr
     return out, two_room_scene.id, proc.stdout
+
+
+def test_commands_select_headless_egl_themselves():
+    """``headless_gl`` (called first by every command that renders): EGL where its library is installed and
+    ``MUJOCO_GL`` is unset; a value the user set is kept."""
+    code = "from ignjax.scenes.viz import headless_gl; import os; print(headless_gl(), os.environ.get('PYOPENGL_PLATFORM'))"
+    bare = {k: v for k, v in os.environ.items() if k not in ("MUJOCO_GL", "PYOPENGL_PLATFORM", "DISPLAY")}
+    import ctypes.util
+
+    got = subprocess.run([sys.executable, "-c", code], env=bare, capture_output=True, text=True, timeout=60)
+    want = "egl egl" if sys.platform.startswith("linux") and ctypes.util.find_library("EGL") else "None None"
+    assert got.stdout.split() == want.split(), got.stderr
+    kept = subprocess.run([sys.executable, "-c", code], env=dict(bare, MUJOCO_GL="osmesa"), capture_output=True,
+                          text=True, timeout=60)
+    assert kept.stdout.split() == ["osmesa", "osmesa"], kept.stderr
 
 
 def _image(path) -> np.ndarray:

@@ -10,15 +10,29 @@ do), or set ``MUJOCO_GL=egl`` themselves.
 
 from __future__ import annotations
 
+import ctypes.util
 import os
+import sys
 
 
-def headless_gl() -> None:
+def headless_gl() -> str | None:
     """Default MuJoCo to headless EGL rendering (``MUJOCO_GL=egl``,
-    ``PYOPENGL_PLATFORM=egl``; ``osmesa`` keeps its own platform); a value
-    the user set is kept. Effective only before ``mujoco`` is imported."""
-    os.environ.setdefault("MUJOCO_GL", "egl")
-    os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa" if os.environ["MUJOCO_GL"] == "osmesa" else "egl")
+    ``PYOPENGL_PLATFORM=egl``) on Linux when the EGL library is installed;
+    a ``MUJOCO_GL`` the user set is kept (``osmesa`` keeps its own
+    platform). Every command that renders calls it first thing
+    (``sweep``, ``evaluate``, ``bench``, ``build``, ``view``), so rendering
+    needs no environment variable on a machine without a display. Effective
+    only before ``mujoco`` is imported.
+
+    Returns:
+        The ``MUJOCO_GL`` now in effect (None: unset, MuJoCo's own default).
+    """
+    if not os.environ.get("MUJOCO_GL") and sys.platform.startswith("linux") and ctypes.util.find_library("EGL"):
+        os.environ["MUJOCO_GL"] = "egl"
+    gl = os.environ.get("MUJOCO_GL") or None
+    if gl in ("egl", "osmesa"):
+        os.environ.setdefault("PYOPENGL_PLATFORM", gl)
+    return gl
 
 
 __all__ = ["headless_gl"]
