@@ -250,7 +250,7 @@ _object_fields = jax.jit(jax.vmap(_object_field, in_axes=(None, None, None, None
 
 
 def goal_fields(grid: NavGrid, boxes: list, room_indices: list[int], seed_radius: float,
-                shape: tuple[int, int] | None = None) -> np.ndarray:
+                shape: tuple[int, int] | None = None, device=None) -> np.ndarray:
     """Geodesic fields (K, H, W) float32 to K objects on one grid (vmapped).
 
     The grid is padded (not navigable) to ``shape`` when given (a bank's
@@ -265,6 +265,8 @@ def goal_fields(grid: NavGrid, boxes: list, room_indices: list[int], seed_radius
         boxes: K :class:`~ignjax.scenes.model.OrientedBox` footprints.
         room_indices: K indices into ``grid.room_ids`` (-1: any room).
         seed_radius: metres (see :func:`seeds_from_box`).
+        device: the JAX device to compute on (default: JAX's default device);
+            the same program and bytes on any CPU device.
 
     Returns:
         (K, H, W) float32 metres, +inf where the object cannot be reached.
@@ -277,10 +279,10 @@ def goal_fields(grid: NavGrid, boxes: list, room_indices: list[int], seed_radius
     nav[:H, :W] = grid.navigable
     room = np.full((Hp, Wp), -1, np.int32)
     room[:H, :W] = grid.room
-    centers = jnp.asarray(np.array([b.center for b in boxes], np.float32))
-    halves = jnp.asarray(np.array([b.half_extents for b in boxes], np.float32))
-    yaws = jnp.asarray(np.array([b.yaw for b in boxes], np.float32))
-    out = _object_fields(jnp.asarray(nav), jnp.asarray(room), jnp.asarray(grid.origin, jnp.float32),
-                         float(grid.resolution), centers, halves, yaws, jnp.asarray(np.array(room_indices, np.int32)),
-                         float(seed_radius))
+    args = jax.device_put((nav, room, np.asarray(grid.origin, np.float32),
+                           np.array([b.center for b in boxes], np.float32),
+                           np.array([b.half_extents for b in boxes], np.float32),
+                           np.array([b.yaw for b in boxes], np.float32), np.array(room_indices, np.int32)), device)
+    nav_, room_, origin, centers, halves, yaws, rooms = args
+    out = _object_fields(nav_, room_, origin, float(grid.resolution), centers, halves, yaws, rooms, float(seed_radius))
     return np.asarray(out)[:, :H, :W]

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 from collections import OrderedDict
+from concurrent.futures import ThreadPoolExecutor
 
 import jax
 import jax.numpy as jnp
@@ -20,6 +21,7 @@ import numpy as np
 
 from ignjax.arrays import pytree_dataclass
 from ignjax.cache import array_digest, code_digest, derived_store, digest
+from ignjax.devices import available_cores
 from ignjax.errors import ConfigError
 from ignjax.scenes.bank import SceneBank
 from ignjax.sim import types as T
@@ -115,50 +117,65 @@ def _probe_bits(bank: SceneBank, config: T.SimConfig) -> np.ndarray:
     ``FINE_GROW`` fine cells (voxels entirely inside
     a primitive, and segments with more primitives than the ray grid lists
     or marked approximate, count as occupied); cells outside the ray grid
-    are free."""
+    are free. The scenes are computed in threads, one per usable core (their
+    numpy operations are large and release the GIL); each scene's bits
+    depend on that scene alone."""
     g, r = bank.grid, bank.rays
     S, H, W = np.asarray(g.navigable).shape
-    vox = np.asarray(r.voxcode)
-    seg_start, seg_count = np.asarray(r.seg_start), np.asarray(r.seg_count)
-    seg_prims, approx, prims = np.asarray(r.seg_prims), np.asarray(r.approx), np.asarray(r.prims)
-    fr = g.resolution / FINE
-    rows, cols = np.meshgrid(np.arange(H * FINE), np.arange(W * FINE), indexing="ij")
+    tables = {n: np.asarray(getattr(r, n)) for n in ("voxcode", "seg_start", "seg_count", "seg_prims", "approx",
+                                                     "prims", "origin", "dims")}
     out = np.zeros((S, H * FINE, W * FINE), np.uint8)
-    maxc = max(int(seg_count.max(initial=0)), 1)
-    for si in range(S):
-        x = float(np.asarray(g.origin[si, 0])) + (cols + 0.5) * fr
-        y = float(np.asarray(g.origin[si, 1])) + (rows + 0.5) * fr
-        vc = np.floor((x - float(np.asarray(r.origin[si, 0]))) / r.resolution).astype(np.int64)
-        vr = np.floor((y - float(np.asarray(r.origin[si, 1]))) / r.resolution).astype(np.int64)
-        wv, hv, zv = (int(v) for v in np.asarray(r.dims[si]))
-        inside = (vc >= 0) & (vc < wv) & (vr >= 0) & (vr < hv)
-        vcc, vrr = np.clip(vc, 0, vox.shape[3] - 1), np.clip(vr, 0, vox.shape[2] - 1)
-        bits = np.zeros(rows.shape, np.uint8)
-        for j, h in enumerate(probe_heights(config)):
-            k = int(math.floor(h / r.slice_height + 1e-6))
-            if k >= zv:
-                occ = np.zeros(rows.shape, bool)
-            else:
-                code = vox[si, k, vrr, vcc]
-                occ = code == 1
-                part = np.nonzero((code == 0) & inside)
-                if len(part[0]):
-                    band = min(k // r.slices_per_band, seg_start.shape[3] - 1)
-                    pr, pc = vrr[part], vcc[part]
-                    st = seg_start[si, pr, pc, band]
-                    cnt = seg_count[si, pr, pc, band].astype(np.int64)
-                    rough = approx[si, pr, pc, band]
-                    idx = np.clip(st[:, None] + np.arange(maxc)[None], 0, seg_prims.shape[1] - 1)
-                    ids = seg_prims[si, idx]
-                    use = (np.arange(maxc)[None] < cnt[:, None]) & (ids >= 0)
-                    rows_p = prims[si][:, np.clip(ids, 0, prims.shape[2] - 1)].transpose(1, 2, 0)  # (n, maxc, 18)
-                    pts = np.stack([x[part], y[part], np.full(len(pr), h)], 1)
-                    hit = np.any(_inside_prims(rows_p, pts, FINE_GROW * fr) & use, axis=1) | rough
-                    occ = occ.copy()
-                    occ[part] = hit
-            bits |= (np.where(inside, occ, False).astype(np.uint8) << j)
-        out[si] = bits
+    origins = np.asarray(g.origin)
+
+    def one(si):
+        out[si] = _scene_probe_bits(si, tables, origins[si], g.resolution, (H, W), r, config)
+
+    with ThreadPoolExecutor(max(1, min(S, available_cores()))) as pool:
+        list(pool.map(one, range(S)))
     return out
+
+
+def _scene_probe_bits(si: int, t: dict, origin: np.ndarray, resolution: float, shape: tuple[int, int], r,
+                      config: T.SimConfig) -> np.ndarray:
+    """Scene ``si``'s (FINE H, FINE W) probe bits (:func:`_probe_bits`; ``t``: the ray grid's host tables)."""
+    H, W = shape
+    vox, seg_start, seg_count, seg_prims, approx, prims = (t[n] for n in ("voxcode", "seg_start", "seg_count",
+                                                                           "seg_prims", "approx", "prims"))
+    fr = resolution / FINE
+    rows, cols = np.meshgrid(np.arange(H * FINE), np.arange(W * FINE), indexing="ij")
+    maxc = max(int(seg_count.max(initial=0)), 1)
+    x = float(origin[0]) + (cols + 0.5) * fr
+    y = float(origin[1]) + (rows + 0.5) * fr
+    vc = np.floor((x - float(t["origin"][si, 0])) / r.resolution).astype(np.int64)
+    vr = np.floor((y - float(t["origin"][si, 1])) / r.resolution).astype(np.int64)
+    wv, hv, zv = (int(v) for v in t["dims"][si])
+    inside = (vc >= 0) & (vc < wv) & (vr >= 0) & (vr < hv)
+    vcc, vrr = np.clip(vc, 0, vox.shape[3] - 1), np.clip(vr, 0, vox.shape[2] - 1)
+    bits = np.zeros(rows.shape, np.uint8)
+    for j, h in enumerate(probe_heights(config)):
+        k = int(math.floor(h / r.slice_height + 1e-6))
+        if k >= zv:
+            occ = np.zeros(rows.shape, bool)
+        else:
+            code = vox[si, k, vrr, vcc]
+            occ = code == 1
+            part = np.nonzero((code == 0) & inside)
+            if len(part[0]):
+                band = min(k // r.slices_per_band, seg_start.shape[3] - 1)
+                pr, pc = vrr[part], vcc[part]
+                st = seg_start[si, pr, pc, band]
+                cnt = seg_count[si, pr, pc, band].astype(np.int64)
+                rough = approx[si, pr, pc, band]
+                idx = np.clip(st[:, None] + np.arange(maxc)[None], 0, seg_prims.shape[1] - 1)
+                ids = seg_prims[si, idx]
+                use = (np.arange(maxc)[None] < cnt[:, None]) & (ids >= 0)
+                rows_p = prims[si][:, np.clip(ids, 0, prims.shape[2] - 1)].transpose(1, 2, 0)  # (n, maxc, 18)
+                pts = np.stack([x[part], y[part], np.full(len(pr), h)], 1)
+                hit = np.any(_inside_prims(rows_p, pts, FINE_GROW * fr) & use, axis=1) | rough
+                occ = occ.copy()
+                occ[part] = hit
+        bits |= (np.where(inside, occ, False).astype(np.uint8) << j)
+    return bits
 
 
 PROBE_MAPS_KEPT = 8
