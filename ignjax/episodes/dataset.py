@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import dataclasses
 import os
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -343,9 +342,8 @@ def compute_fields(bank: SceneBank, pairs: list[tuple[int, int]], batch: int = F
     front of :func:`~ignjax.scenes.geodesic.goal_fields`, the batcher
     benchmark construction uses), ``batch`` at a time, seed radius 1 m, on
     the bank's padded grid (one compiled program for every scene);
-    ``progress`` wraps the iteration over finished scenes. Scenes run in
-    threads, one per local device (on CPU one device per core,
-    :func:`ignjax.devices.configure_cpu_devices`). The bank's padding is
+    ``progress`` wraps the iteration over scenes. Each call's targets are
+    split over the local devices (on CPU one per core). The bank's padding is
     +inf. The fields equal :func:`~ignjax.scenes.bank.target_fields` on the
     bank's grid, byte for byte (checked on the shipped benchmark).
     """
@@ -356,21 +354,11 @@ def compute_fields(bank: SceneBank, pairs: list[tuple[int, int]], batch: int = F
     for f, (s, i) in enumerate(pairs):
         by_scene.setdefault(s, []).append((f, i))
     scenes = list(by_scene)
-    devices = jax.local_devices()
-
-    def one(k: int) -> int:
-        s = scenes[k]
+    for s in (progress(scenes) if progress else scenes):
         items, grid = by_scene[s], bank.navgrids[s]
         fields = cached_goal_fields(bank.compiled[s], grid, [i for _, i in items], [int(rooms[s, i]) for _, i in items],
-                                    1.0, batch, (H, W), device=devices[k % len(devices)])
+                                    1.0, batch, (H, W))
         h, w = grid.shape
         for (f, _), field in zip(items, fields):
             out[f, :h, :w] = field
-        return s
-
-    # scenes in threads, one per device (on CPU, one per core): the same program on each, the same bytes
-    with ThreadPoolExecutor(max(1, min(len(scenes), len(devices)))) as pool:
-        done = pool.map(one, range(len(scenes)))
-        for _ in (progress(done) if progress else done):
-            pass
     return jnp.asarray(out)

@@ -61,16 +61,14 @@ def cached_navgrid(compiled, config: GridConfig = GridConfig()) -> NavGrid:
 
 
 def cached_goal_fields(compiled, grid: NavGrid, instances: list[int], room_indices: list[int],
-                       seed_radius: float, batch: int, shape: tuple[int, int] | None = None,
-                       device=None) -> list[np.ndarray]:
+                       seed_radius: float, batch: int, shape: tuple[int, int] | None = None) -> list[np.ndarray]:
     """The (H, W) float32 geodesic field to each of ``instances`` (indices
     into the scene's instances; ``room_indices`` their rooms in
     ``grid.room_ids``) on ``grid``, through the cache. Missing fields are
     computed :func:`~ignjax.scenes.geodesic.goal_fields` ``batch`` at a time
     (a short batch padded by repeating its last target, so one program
     serves every batch of a grid shape; ``shape``: the padded grid it runs
-    on, see :func:`~ignjax.scenes.geodesic.goal_fields`; ``device``: the
-    JAX device they run on, default JAX's)."""
+    on, see :func:`~ignjax.scenes.geodesic.goal_fields`)."""
     store = derived_store()
     keys = [None] * len(instances)
     out: list[np.ndarray | None] = [None] * len(instances)
@@ -86,7 +84,7 @@ def cached_goal_fields(compiled, grid: NavGrid, instances: list[int], room_indic
         chunk = todo[c:c + batch]
         padded = chunk + [chunk[-1]] * (batch - len(chunk))
         fields = goal_fields(grid, [boxes[instances[k]].bbox for k in padded], [int(room_indices[k]) for k in padded],
-                             seed_radius, shape, device)
+                             seed_radius, shape)
         for j, k in enumerate(chunk):
             out[k] = fields[j]
             if store is not None:

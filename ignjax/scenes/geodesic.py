@@ -9,11 +9,13 @@ one object on a :class:`~ignjax.scenes.navgrid.NavGrid`.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import jax
 import jax.numpy as jnp
 import numpy as np
+from jax.sharding import Mesh, PartitionSpec as P
 
 from ignjax.scenes.model import OrientedBox
 from ignjax.scenes.navgrid import NavGrid
@@ -244,13 +246,27 @@ def _object_field(navigable, room, origin, resolution, center, half_extents, yaw
     return geodesic_field(navigable, seeds, resolution)
 
 
-# One jitted program for every caller (compiled once per padded grid shape, K, resolution and seed radius).
-_object_fields = jax.jit(jax.vmap(_object_field, in_axes=(None, None, None, None, 0, 0, 0, 0, None)),
-                         static_argnums=(3, 8))
+FIELD_AXIS = "fields"
+
+
+@functools.lru_cache(maxsize=None)
+def _fields_program(parts: int, resolution: float, seed_radius: float):
+    """One jitted program for every caller: :func:`_object_field` vmapped
+    over targets, the targets split over this process's first ``parts``
+    devices (on CPU one device per core; a field's lanes never mix, so the
+    bytes are the same on any number of devices). Compiled once per padded
+    grid shape, K, device count, resolution and seed radius."""
+    mesh = Mesh(np.array(jax.local_devices()[:parts]), (FIELD_AXIS,))
+    fields = jax.vmap(lambda nav, room, origin, c, h, yaw, r: _object_field(nav, room, origin, resolution, c, h, yaw,
+                                                                            r, seed_radius),
+                      in_axes=(None, None, None, 0, 0, 0, 0))
+    lanes = P(FIELD_AXIS)
+    return jax.jit(jax.shard_map(fields, mesh=mesh, in_specs=(P(), P(), P(), lanes, lanes, lanes, lanes),
+                                 out_specs=lanes, check_vma=False))
 
 
 def goal_fields(grid: NavGrid, boxes: list, room_indices: list[int], seed_radius: float,
-                shape: tuple[int, int] | None = None, device=None) -> np.ndarray:
+                shape: tuple[int, int] | None = None) -> np.ndarray:
     """Geodesic fields (K, H, W) float32 to K objects on one grid (vmapped).
 
     The grid is padded (not navigable) to ``shape`` when given (a bank's
@@ -265,8 +281,6 @@ def goal_fields(grid: NavGrid, boxes: list, room_indices: list[int], seed_radius
         boxes: K :class:`~ignjax.scenes.model.OrientedBox` footprints.
         room_indices: K indices into ``grid.room_ids`` (-1: any room).
         seed_radius: metres (see :func:`seeds_from_box`).
-        device: the JAX device to compute on (default: JAX's default device);
-            the same program and bytes on any CPU device.
 
     Returns:
         (K, H, W) float32 metres, +inf where the object cannot be reached.
@@ -279,10 +293,12 @@ def goal_fields(grid: NavGrid, boxes: list, room_indices: list[int], seed_radius
     nav[:H, :W] = grid.navigable
     room = np.full((Hp, Wp), -1, np.int32)
     room[:H, :W] = grid.room
-    args = jax.device_put((nav, room, np.asarray(grid.origin, np.float32),
-                           np.array([b.center for b in boxes], np.float32),
-                           np.array([b.half_extents for b in boxes], np.float32),
-                           np.array([b.yaw for b in boxes], np.float32), np.array(room_indices, np.int32)), device)
-    nav_, room_, origin, centers, halves, yaws, rooms = args
-    out = _object_fields(nav_, room_, origin, float(grid.resolution), centers, halves, yaws, rooms, float(seed_radius))
-    return np.asarray(out)[:, :H, :W]
+    K = len(boxes)
+    parts = min(len(jax.local_devices()), K)
+    extra = -K % parts  # K padded to whole shares with copies of the last target
+    boxes, rooms = list(boxes) + [boxes[-1]] * extra, list(room_indices) + [room_indices[-1]] * extra
+    out = _fields_program(parts, float(grid.resolution), float(seed_radius))(
+        nav, room, np.asarray(grid.origin, np.float32), np.array([b.center for b in boxes], np.float32),
+        np.array([b.half_extents for b in boxes], np.float32), np.array([b.yaw for b in boxes], np.float32),
+        np.array(rooms, np.int32))
+    return np.asarray(out)[:K, :H, :W]
