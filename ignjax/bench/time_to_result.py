@@ -2,9 +2,9 @@
 researcher waits for a result, the first time (an empty cache folder) and
 the second (the same folder, a new process).
 
-Each task runs twice in a fresh ``python -m ignjax.bench.time_to_result
-TASK OUT`` process with ``IGNJAX_CACHE_DIR`` set to a new temporary folder
-(cold), then again on that folder (warm):
+Each task runs in a fresh ``python -m ignjax.bench.time_to_result COMMAND
+OUT ARGS...`` process with ``IGNJAX_CACHE_DIR`` set to a new temporary
+folder (cold), then in another on that folder (warm):
 
 * ``evaluate`` - ``python -m ignjax.evaluate --agent eig`` on the shipped
   500 episodes (or ``--episodes``);
