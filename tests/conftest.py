@@ -78,7 +78,8 @@ configure_cpu_devices(2)
 
 if os.environ.get("IGNJAX_TEST_COMPILE_LOG"):
     # Where the suite's compile time goes: each program this process compiles or loads from the cache, one line
-    # "test <tab> program <tab> seconds" in IGNJAX_TEST_COMPILE_LOG.<pid> (a diagnostic; off unless set).
+    # "test <tab> program <tab> seconds" in IGNJAX_TEST_COMPILE_LOG.<pid>, after a line with the program's argument
+    # shapes (a diagnostic; off unless set).
     import jax  # noqa: E402
 
     def _log_compile(event, duration, **kw):
@@ -88,6 +89,25 @@ if os.environ.get("IGNJAX_TEST_COMPILE_LOG"):
                 fh.write(f"{test}\t{kw.get('fun_name', '?')}\t{duration:.3f}\n")
 
     jax.monitoring.register_event_duration_secs_listener(_log_compile)
+
+    import hashlib  # noqa: E402
+    import logging  # noqa: E402
+
+    class _Shapes(logging.Handler):
+        """Each program's argument shapes before it is compiled: a line "test <tab> shapes: program <tab> digest
+        <tab> shapes", so programs that differ only by an input's shape can be found."""
+
+        def emit(self, record):
+            if not str(record.msg).startswith("Compiling"):
+                return
+            name, avals = record.args[0], str(record.args[1])
+            test = os.environ.get("PYTEST_CURRENT_TEST", "-").rsplit(" ", 1)[0]
+            with open(f"{os.environ['IGNJAX_TEST_COMPILE_LOG']}.{os.getpid()}", "a") as fh:
+                fh.write(f"{test}\tshapes: {name}\t{hashlib.sha1(avals.encode()).hexdigest()[:10]}\t{avals[:4000]}\n")
+
+    _pxla_log = logging.getLogger("jax._src.interpreters.pxla")
+    _pxla_log.setLevel(logging.DEBUG)
+    _pxla_log.addHandler(_Shapes(logging.DEBUG))
 
 ROOT = Path(__file__).resolve().parents[1]
 IN_CI = os.environ.get("CI", "").strip().lower() not in ("", "0", "false", "no")
