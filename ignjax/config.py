@@ -439,9 +439,9 @@ QUICK: dict[str, dict[str, Any]] = {
     "costs": {"samples": 20_000, "scales": [0.25, 1.0, 4.0]},
     "difficulty": {"alpha_step": 0.1, "threshold_step": 0.1},
     "analysis": {"trajectories": 2},
-    "views": {"size": 224},
 }
-"""The sizes ``--quick`` replaces (CI and smoke runs)."""
+"""The sizes ``--quick`` replaces (CI and smoke runs). The image size is not one of them: a quick run's
+MLLM agents see the views a full run's see (``views.size``, :data:`ignjax.sim.views.config.DEFAULT_SIZE`)."""
 
 
 @functools.cache

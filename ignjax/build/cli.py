@@ -258,7 +258,8 @@ def cmd_render(args) -> int:
     plot_scene_map(scene, out / f"{scene.id}_map.png")
     # the views as the agents see them (ignjax.sim.views): executor cameras, Planner panel, Grounder image
     bank = SceneBank.from_compiled([compiled], [grid])
-    with ViewRenderer(bank, SimConfig(), ViewConfig(size=args.size, backend=args.backend)) as r:
+    size = {} if args.size is None else {"size": args.size}  # None: ViewConfig's default
+    with ViewRenderer(bank, SimConfig(), ViewConfig(**size, backend=args.backend)) as r:
         views = r.render([0], [[x, y, yaw]])
         panel = r.panels(views)[0]
         grounder = r.grounder_images(views, [0])[0]
@@ -310,7 +311,8 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--scene", help="scene id, when the source holds several (default: the first)")
     r.add_argument("--out", default=".", help="output folder (default: current folder)")
     r.add_argument("--pose", help="eye pose x,y,yaw (metres, radians); default: an open spot of the first room")
-    r.add_argument("--size", type=int, default=448, help="pixels per view, 64..1024 (default 448)")
+    r.add_argument("--size", type=int, default=None,
+                   help="pixels per view, 64..1024 (default: ViewConfig's, ignjax.sim.views.config.DEFAULT_SIZE)")
     r.add_argument("--backend", default="auto", choices=("auto", "warp", "egl"),
                    help="renderer (default auto: MuJoCo Warp when installed, else OpenGL)")
     r.set_defaults(func=cmd_render)

@@ -11,7 +11,16 @@ agent, overall and per difficulty), ``OUT/trajectories.npz`` (every agent's
 per-step trajectories, which ``python -m ignjax.view OUT`` replays; a few kB
 per episode and agent, so always written), ``OUT/run.json`` (every setting
 used: the simulator's, each agent's parameters, costs, thresholds, success
-rule, seed) and prints the paper's Table-1 columns.
+rule, seed; ``image_size``: pixels per side of the views the MLLM agents were
+shown, ``views.size``, by default :data:`ignjax.sim.views.config.DEFAULT_SIZE`,
+null when no agent rendered) and prints the paper's Table-1 columns.
+
+With an MLLM agent, every ``--llm-endpoint`` is asked for its models
+(:func:`ignjax.agents.llm.models.check_served`) before any scene is loaded:
+an endpoint that does not answer within ``llm.timeout_s``, or a
+``--llm-model`` it does not serve, is an error (exit status 2) naming the
+endpoint, or the model and the ones served. ``--llm-replay`` and
+``--dry-run`` ask nothing.
 
 ``--set sim.<key>=<value>`` sets any :class:`~ignjax.sim.types.SimConfig`
 field and ``--set agents.<name>.<key>=<value>`` any agent parameter (the keys
@@ -102,7 +111,8 @@ def build_parser() -> argparse.ArgumentParser:
                              " and --set views.<key>=<value>")
     g.add_argument("--llm-endpoint", action="append", default=[], metavar="URL",
                    help="OpenAI-compatible base URL, e.g. http://127.0.0.1:8000/v1; repeat for several servers")
-    g.add_argument("--llm-model", help="the served model's name")
+    g.add_argument("--llm-model", help="the served model's name (checked against each endpoint's GET /models before "
+                                       "any scene is loaded)")
     g.add_argument("--llm-key-env", default=None,
                    help="environment variable holding the API key (default OPENAI_API_KEY; unset: no key sent)")
     g.add_argument("--llm-cache", default=None, help="response cache folder (default OUT/llm_cache)")
@@ -186,7 +196,7 @@ def llm_settings(args, sections: dict, out_dir: Path):
             raise ConfigError(None, flag, "an MLLM agent needs the model server's base URL (--llm-endpoint) and the "
                                           "served model's name (--llm-model)")
     llm = LLMConfig.from_dict(d, where="--llm-*/--set llm")
-    v = {"size": 224, **sections.get("views", {})}
+    v = dict(sections.get("views", {}))  # the size: ViewConfig's default, DEFAULT_SIZE, unless views.size
     try:
         views = ViewConfig(**v)
     except TypeError as e:
@@ -267,6 +277,19 @@ def check_settings(args, popts: PR.ProcessOptions = PR.ProcessOptions()) -> dict
             "llm": llm, "views": views, "thresholds": thresholds, "costs": costs}
 
 
+def _check_model_server(llm) -> None:
+    """With MLLM agents (``llm`` set): every endpoint answers and serves ``--llm-model``, checked before any scene
+    is loaded (:func:`ignjax.agents.llm.models.check_served`; nothing is asked under ``--llm-replay``).
+
+    Raises:
+        ConfigError: naming ``--llm-endpoint`` and the endpoint, or ``--llm-model``, the model and the ones served.
+    """
+    if llm is not None:
+        from ignjax.agents.llm.models import check_served  # aiohttp
+
+        check_served(llm, "--llm-model", "--llm-endpoint")
+
+
 def _fingerprint(args, sim, used: dict) -> str:
     """What a JAX-native agent's outcomes depend on: a part of ``OUT/parts`` is reused only under the same."""
     import hashlib
@@ -294,6 +317,7 @@ def run(args, settings: dict | None = None, popts: PR.ProcessOptions = PR.Proces
     llm_names = {a.name for a in st["llm_agents"]}
     if args.dry_run:
         return _dry_run(args, agents, st["llm_agents"], sim, llm, views, costs)
+    _check_model_server(llm)
     group = PR.start(popts) if group is None else group
     from ignjax.sim.rollout import batch_parts
 
@@ -356,6 +380,12 @@ def run(args, settings: dict | None = None, popts: PR.ProcessOptions = PR.Proces
     return 0
 
 
+def _image_size(st: dict) -> int | None:
+    """Pixels per side of the views the MLLM agents were shown (``views.size``); None when no agent rendered."""
+    panel = [a for a in st["llm_agents"] if getattr(a, "observation", None) == "panel"]
+    return st["views"].size if panel else None
+
+
 def _fields(obj) -> dict:
     return {f.name: np.asarray(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
 
@@ -402,7 +432,7 @@ def _write_outputs(args, st: dict, bs, plan, store, used: dict, llm_names: set) 
     run_record = {"episodes": str(args.episodes), "seed": args.seed, "batch": args.batch, "thresholds": list(thresholds),
                   "costs": list(costs), "require_stop": args.require_stop,
                   "success_rule": M.success_rule(args.require_stop), "sim": sim.to_dict(), "agents": used,
-                  "limit": args.limit, "bank_mb": args.bank_mb,
+                  "limit": args.limit, "bank_mb": args.bank_mb, "image_size": _image_size(st),
                   "model_totals": model_totals(rows, llm.prices if llm else None)}
     atomic_write(out_dir / "run.json", json.dumps(run_record, indent=2) + "\n")
     print(M.success_rule(args.require_stop))

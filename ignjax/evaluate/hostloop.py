@@ -709,7 +709,7 @@ IMAGE_TOKEN_PX = 28
 merged 2x2); other models count differently, so the figure is an estimate."""
 
 
-def dry_run(agent: LLMAgent, n_episodes: int, *, sim: T.SimConfig = T.SimConfig(), views: ViewConfig = ViewConfig(size=224),
+def dry_run(agent: LLMAgent, n_episodes: int, *, sim: T.SimConfig = T.SimConfig(), views: ViewConfig = ViewConfig(),
             llm: LLMConfig | None = None, costs=LOCKED_COSTS) -> dict:
     """What running ``agent`` on ``n_episodes`` episodes would send at most,
     before sending anything: requests (every decision a Planner call, every
@@ -768,7 +768,7 @@ def dry_run(agent: LLMAgent, n_episodes: int, *, sim: T.SimConfig = T.SimConfig(
 
 
 def run_llm_agent(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, *, sim: T.SimConfig = T.SimConfig(),
-                  views: ViewConfig = ViewConfig(size=224), batch: int = 64, seed: int = 0, costs=LOCKED_COSTS,
+                  views: ViewConfig = ViewConfig(), batch: int = 64, seed: int = 0, costs=LOCKED_COSTS,
                   out: str | os.PathLike | None = None, save_images: int = 0, progress: bool = False, world=None,
                   renderer=None) -> LoopResult:
     """Run an MLLM agent over every episode of ``es`` (module docstring).
@@ -780,7 +780,8 @@ def run_llm_agent(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, *, sim: T.Sim
         sim: simulator settings (``n_views`` is the panel's view count); an
             agent's ``sim_overrides`` (e.g. ``tandem-4v``'s view count) replace
             the settings they name.
-        views: image settings (default 224 px views: a 672 px panel).
+        views: image settings (default :data:`~ignjax.sim.views.config.DEFAULT_SIZE`, 448 px views: a
+            1344 px panel).
         batch: episodes in flight at once (slots).
         seed: seed of the episodes' keys (as :func:`ignjax.evaluate.runner.run_agent`).
         costs: the question costs shown to a cost-aware agent.

@@ -498,6 +498,14 @@ def settings_lines(sim: dict, agents: dict[str, dict]) -> list[str]:
     return lines
 
 
+def mllm_settings_line(cfg: SweepConfig) -> str:
+    """The report header's line on what the MLLM agents were sent: the model, its decoding settings and the
+    image size (``views.size``)."""
+    llm, views = cfg.llm, cfg.views
+    return (f"- MLLM agents: model `{llm.model}`, temperature {llm.temperature:g}, max_tokens {llm.max_tokens}, "
+            f"seed {llm.seed}; views of {views.size} x {views.size} px (`views.size`), {views.image_format}.")
+
+
 def write_outputs(results: dict, out: Path) -> None:
     """Run the table-and-figure part of each study in ``results["studies"]`` and write ``report.md``."""
     cfg, studies = results["config"], results["studies"]
@@ -511,13 +519,15 @@ def write_outputs(results: dict, out: Path) -> None:
                   f"costs charged (and planned with) {tuple(cfg.eval.costs)}; {M.success_rule(cfg.eval.require_stop)}.",
                   ""]
         agents = list(dict.fromkeys(list(cfg.eval.agents) + ([cfg.analysis.agent] if "analysis" in studies else [])))
-        parts += settings_lines(cfg.to_dict()["sim"], cfg.agents.used(agents)) + [""]
+        parts += settings_lines(cfg.to_dict()["sim"], cfg.agents.used(agents))
+        parts += [mllm_settings_line(cfg)] if any(a in LLM_AGENTS for a in agents) else []
+        parts += [""]
     for name, section in SECTIONS.items():
         if name in studies:
             parts += section(results, es, rollouts, cfg, out)
     atomic_write(out / "report.md", "\n".join(parts))
 
 
-__all__ = ["SECTIONS", "VIEWER_FILE", "settings_lines", "agent_arrays", "factors_of", "in_loop_costs",
+__all__ = ["SECTIONS", "VIEWER_FILE", "settings_lines", "agent_arrays", "factors_of", "in_loop_costs", "mllm_settings_line",
            "plot_trajectories", "question_content", "study_analysis", "study_costs",
            "study_derive_costs", "study_difficulty", "study_eval", "write_csv", "write_outputs"]

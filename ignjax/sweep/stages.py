@@ -9,7 +9,10 @@ server, with the ``[views]`` observations, ``eval.batch`` episodes in
 flight, the charged ``eval.costs`` shown to it and ``run.seed``. Its
 checkpoint is the host loop's own (``<run>/llm/<agent>.progress.jsonl``,
 one line per finished episode), so ``--resume`` after a kill continues
-episode by episode; replies are cached in ``llm.cache_dir`` (default
+episode by episode. Before any work, every ``llm.endpoints`` URL is asked for
+its models (:func:`ignjax.agents.llm.models.check_served`, not under
+``llm.replay``): one that does not answer, or an ``llm.model`` it does not
+serve, is an error naming it. Replies are cached in ``llm.cache_dir`` (default
 ``<run>/llm_cache``), and transcripts go to ``<run>/transcripts/<agent>.jsonl``;
 the question texts the agent wrote (:func:`ignjax.evaluate.hostloop.question_texts`)
 stay with its rollout for the analysis study."""
@@ -199,6 +202,29 @@ def rollout_stage_parts(bs: BenchmarkScenes, plans: dict, todo: dict, cfg: Sweep
 # ---------------------------------------------------------------------------
 
 
+def check_model_server(cfg: SweepConfig, studies: list[str]) -> None:
+    """Before any work: when ``studies`` roll out an MLLM agent (in ``eval.agents``, or ``analysis.agent``
+    under the analysis study), the ``[llm]`` table names a server, and every endpoint answers and serves
+    ``llm.model`` (:func:`ignjax.agents.llm.models.check_served`; nothing is asked under ``llm.replay``).
+
+    Raises:
+        ConfigError: naming the missing setting, the endpoint that did not answer, or the model and the ones served.
+    """
+    if "analysis" in studies and cfg.analysis.agent in LLM_AGENTS:  # (eval.agents is checked with the config)
+        try:
+            cfg.llm.check_usable()
+        except ConfigError as e:
+            raise ConfigError(None, e.where, f"{e.reason}: analysis.agent is the MLLM agent {cfg.analysis.agent!r}, "
+                                             "which needs a model server (llm.endpoints, llm.model)") from None
+    if not any(s in studies for s in ("eval", "costs", "difficulty", "analysis")):
+        return  # nothing is rolled out
+    agents = list(cfg.eval.agents) + ([cfg.analysis.agent] if "analysis" in studies else [])
+    if any(a in LLM_AGENTS for a in agents):
+        from ignjax.agents.llm.models import check_served  # aiohttp
+
+        check_served(cfg.llm)
+
+
 def run_sweep(cfg: SweepConfig, studies: list[str], out: Path, *, resume: bool = False, force: bool = False,
               quiet: bool = False, group: ProcessGroup = SINGLE) -> dict:
     """Run ``studies`` with configuration ``cfg`` (see :func:`ignjax.config.resolve`) into ``out``.
@@ -218,12 +244,7 @@ def run_sweep(cfg: SweepConfig, studies: list[str], out: Path, *, resume: bool =
     out = Path(out)
     if cfg.derive_costs.annotations and not Path(cfg.derive_costs.annotations).is_file():
         raise InputError(cfg.derive_costs.annotations, "derive-costs.annotations", "file not found")
-    if "analysis" in studies and cfg.analysis.agent in LLM_AGENTS:  # (eval.agents is checked with the config)
-        try:
-            cfg.llm.check_usable()
-        except ConfigError as e:
-            raise ConfigError(None, e.where, f"{e.reason}: analysis.agent is the MLLM agent {cfg.analysis.agent!r}, "
-                                             "which needs a model server (llm.endpoints, llm.model)") from None
+    check_model_server(cfg, studies)
     needs_rollouts = any(s in studies for s in ("eval", "costs", "difficulty", "analysis"))
     agents = list(dict.fromkeys(list(cfg.eval.agents) + ([cfg.analysis.agent] if "analysis" in studies else [])))
     if needs_rollouts:
@@ -298,5 +319,5 @@ def run_sweep(cfg: SweepConfig, studies: list[str], out: Path, *, resume: bool =
     return results if group.main else {}
 
 
-__all__ = ["REPO_SCENES", "SHIPPED_BENCHMARK", "benchmark_path", "load_episodes", "merge_stage",
+__all__ = ["REPO_SCENES", "SHIPPED_BENCHMARK", "benchmark_path", "check_model_server", "load_episodes", "merge_stage",
            "rollout_stage_parts", "run_llm_stage", "run_sweep"]

@@ -11,6 +11,7 @@ import jax
 import numpy as np
 import pytest
 
+from ignjax.agents.llm.serve import ScriptedServer
 from ignjax.episodes.dataset import open_benchmark
 from ignjax.errors import ConfigError
 from ignjax.evaluate.cli import main
@@ -111,8 +112,10 @@ def test_bad_bank_budget_and_mllm_agents_on_several_buckets(small_benchmark, sce
     assert main(base + ["--agent", "random", "--bank-mb", "0"]) == 2
     assert "--bank-mb: must be > 0" in capsys.readouterr().err
     tight = (padded_bytes(scenes.host.navgrids) - 1) / 2**20
-    assert main(base + ["--agent", "tandem", "--llm-endpoint", "http://127.0.0.1:9/v1", "--llm-model", "m",
-                        "--bank-mb", f"{tight:.6f}"]) == 2
+    with ScriptedServer() as srv:  # the endpoint answers and serves the model (checked before the scenes load)
+        assert main(base + ["--agent", "tandem", "--llm-endpoint", srv.base_url, "--llm-model", srv.model,
+                            "--bank-mb", f"{tight:.6f}"]) == 2
+        assert srv.stats()["requests"] == 0
     err = capsys.readouterr().err
     assert "--bank-mb" in err and "2 buckets" in err and "one bank" in err
     assert not (tmp_path / "o" / "outcomes.csv").exists()

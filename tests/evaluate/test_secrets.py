@@ -10,6 +10,7 @@ printed holds it, as text, base64 or hex."""
 from __future__ import annotations
 
 import base64
+import json
 import logging
 import secrets
 from pathlib import Path
@@ -43,6 +44,7 @@ def test_api_key_reaches_the_server_and_no_file_of_the_run(tmp_path, monkeypatch
     names = {p.relative_to(out).as_posix() for p in files}
     assert {"run.json", "outcomes.csv", "transcripts/navgpt.jsonl", "llm/navgpt.progress.jsonl",
             "llm_cache/llm_cache.sqlite"} <= names, sorted(names)
+    assert json.loads((out / "run.json").read_text())["image_size"] is None  # navgpt reads text: no view rendered
     printed = capfd.readouterr()
     assert "retry 1" in caplog.text
     texts = {p.relative_to(out).as_posix(): p.read_bytes() for p in files}

@@ -105,6 +105,10 @@ def test_sweep_eval_runs_an_mllm_agent_and_reruns_from_the_cache(rendering, tmp_
                 f"{mean[2]:.0f} / {max(x[2] for x in each)} | {sum(costs) / 3:.6f} / {max(costs):.6f} |") in report
         # the agents' options are stated in the report header; the interaction analyses ran on the MLLM agent's traces
         assert "- Agent `vlm`: observation=panel" in report and "- Agent `tandem-naive`:" in report
+        # what the MLLM agents were sent: the paper's decoding settings and the views' size, in the report and run.json
+        assert (f"- MLLM agents: model `{srv.model}`, temperature 0, max_tokens 1024, seed 0; views of 64 x 64 px "
+                "(`views.size`), jpeg.") in report
+        assert json.loads((tmp_path / "a" / "run.json").read_text())["config"]["views"]["size"] == 64
         section = report.split("## Interaction")[-1]
         assert (tmp_path / "a" / "analysis_per_difficulty.csv").is_file() and "tandem-naive" in section
         # what its Type-3 questions asked, classified from the texts in its transcript: one of each class per episode
@@ -158,6 +162,26 @@ def test_mllm_agent_without_a_server_and_other_llm_config_errors(tmp_path):
     assert not (tmp_path / "never").exists()
     with pytest.raises(ConfigError, match="unknown key llm.temprature"):
         resolve(None, ["llm.temprature=0.5"])
+
+
+def test_a_model_the_server_does_not_serve_stops_the_sweep_before_any_work(tmp_path, capsys):
+    """Checked before the run folder is made, for an MLLM agent in eval.agents or as analysis.agent."""
+    with ScriptedServer() as srv:
+        sets = [s for s in _sets(srv, tmp_path, tmp_path / "cache") if not s.startswith("llm.model")]
+        for study, wrong in (("eval", "eval.agents=['random', 'vlm']"), ("analysis", "eval.agents=['random']")):
+            argv = ["--study", study, "--quiet", "--out", str(tmp_path / study)]
+            argv += sum((["--set", s] for s in sets + [wrong, "llm.model='qwen2-vl'"]), [])
+            assert main(argv) == 2
+            err = capsys.readouterr().err
+            assert f"error: llm.model: model 'qwen2-vl' is not served: {srv.base_url} serves '{srv.model}'" in err
+            assert not (tmp_path / study).exists()
+        assert srv.stats()["requests"] == 0
+    # where nothing answers: the endpoint named
+    dead = sets + [f"llm.model='{srv.model}'"]  # the server has stopped: nothing listens at its URL
+    argv = ["--study", "eval", "--quiet", "--out", str(tmp_path / "dead")] + sum((["--set", s] for s in dead), [])
+    assert main(argv) == 2
+    assert f"error: llm.endpoints: {srv.base_url} did not list its models" in capsys.readouterr().err
+    assert not (tmp_path / "dead").exists()
 
 
 def test_where_the_model_is_served_does_not_change_the_run():

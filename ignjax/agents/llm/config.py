@@ -54,10 +54,12 @@ class LLMConfig:
         model: the model name sent in every request.
         api_key_env: NAME of the environment variable holding the API key
             (``None`` or ``""``: never send one). Unset variable: no header.
-        temperature: sampling temperature, in [0, 2].
+        temperature: sampling temperature, in [0, 2]; 0 (deterministic
+            decoding), the paper's setting.
         seed: sampling seed sent with each request (``None``: not sent); also
             seeds the retry jitter.
-        max_tokens: completion token limit per request.
+        max_tokens: completion token limit per request; 1024, the paper's
+            cap for each Planner, Grounder and Oracle call.
         timeout_s: total time allowed for one HTTP attempt.
         concurrency: requests in flight at once, per endpoint.
         max_retries: retries of one request after its first attempt.
@@ -97,7 +99,7 @@ class LLMConfig:
     api_key_env: str | None = "OPENAI_API_KEY"
     temperature: float = 0.0
     seed: int | None = 0
-    max_tokens: int = 512
+    max_tokens: int = 1024
     timeout_s: float = 120.0
     concurrency: int = 16
     max_retries: int = 6

@@ -36,6 +36,15 @@ from ignjax.errors import ConfigError
 BACKENDS = ("warp", "egl", "auto")
 FORMATS = ("jpeg", "png")
 MIN_SIZE, MAX_SIZE = 64, 1024
+DEFAULT_SIZE = 448
+"""Pixels per side of a rendered view unless ``views.size`` says otherwise: the one default of
+:class:`ViewConfig`, ``python -m ignjax.evaluate``, ``python -m ignjax.sweep`` (``--quick`` included) and
+``python -m ignjax.build render``. The paper states no image size, so this is a choice: a 448 px view
+is 56 px per cell of the Grounder's 8x8 grid, 2 x 2 vision tokens of 28 px for Qwen2/2.5-VL-style
+models (16 x 16 per view) where 224 px leaves one token per cell, for targets as small as the
+benchmark's mugs, remote controls and books; the 8-view Planner panel is then 1344 px square, about
+2,300 image tokens, which still fits a 16k context beside the prompt and the 1024-token reply. Lower
+it (``--set views.size=224``) for cheap runs."""
 WARP_PACKAGE = "warp-lang"
 
 
@@ -45,7 +54,8 @@ class ViewConfig:
 
     Attributes:
         size: pixels per side of a square view, in [64, 1024]; 448 by
-            default, 224 for cheap runs.
+            default (``DEFAULT_SIZE``, where the choice is explained: the
+            paper states none), 224 for cheap runs.
         backend: ``"warp"``, ``"egl"`` or ``"auto"`` (module docstring).
         fallback: use the other backend when the requested one cannot run.
         worlds: the most episodes one warp call renders (its render context
@@ -75,7 +85,7 @@ class ViewConfig:
             process may use. Keep 1 on a GPU.
     """
 
-    size: int = 448
+    size: int = DEFAULT_SIZE
     backend: str = "auto"
     fallback: bool = True
     worlds: int = 0
@@ -171,4 +181,4 @@ def resolve_backend(config: ViewConfig) -> str:
     return other
 
 
-__all__ = ["BACKENDS", "FORMATS", "MAX_SIZE", "MIN_SIZE", "ViewConfig", "egl_available", "resolve_backend", "warp_available"]
+__all__ = ["BACKENDS", "DEFAULT_SIZE", "FORMATS", "MAX_SIZE", "MIN_SIZE", "ViewConfig", "egl_available", "resolve_backend", "warp_available"]

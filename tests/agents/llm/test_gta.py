@@ -47,7 +47,9 @@ def test_gta_sends_the_requests_of_tandem_without_spatial_memory(rendering, tmp_
     # the same requests, call for call (the hash covers model, settings, schema, messages and images)
     assert {c["role"] for c in gta} == {"planner", "grounder"} and gta == tandem
     # the first agent's requests reached the server; the second's were all answered from the cache
-    totals = json.loads((out / "run.json").read_text())["model_totals"]
+    run = json.loads((out / "run.json").read_text())
+    assert run["image_size"] == 64  # the views the agents were shown (views.size)
+    totals = run["model_totals"]
     assert totals["gta"]["requests"] == sent > 0 and totals["gta"]["cache_hits"] == 0
     assert totals["tandem-no-spmem"]["requests"] == 0 and totals["tandem-no-spmem"]["cache_hits"] == sent
     assert _outcome_rows(out, "gta") == _outcome_rows(out, "tandem-no-spmem")
