@@ -75,6 +75,7 @@ class CompileClock:
 
     def __init__(self):
         self.spans: list[tuple[float, float]] = []
+        self.names: list[str] = []  # the programs obtained, in order (JAX's names, e.g. "jit(_run_sharded)")
         self.programs = 0
         self.cache_hits = 0
         self._on = False
@@ -82,10 +83,12 @@ class CompileClock:
     def start(self) -> "CompileClock":
         import jax  # only a process that measures pays for it here
 
-        def span(event, start, end, **_):
+        def span(event, start, end, **kw):
             if self._on and event in COMPILE_EVENTS:
                 self.spans.append((start, end))
-                self.programs += event == COMPILE_EVENTS[2]
+                if event == COMPILE_EVENTS[2]:
+                    self.programs += 1
+                    self.names.append(str(kw.get("fun_name", "?")))
 
         def count(event, **_):
             if self._on and event == "/jax/compilation_cache/cache_hits":

@@ -41,6 +41,8 @@ from __future__ import annotations
 import dataclasses
 import math
 import weakref
+from collections import OrderedDict
+from concurrent.futures import ThreadPoolExecutor
 from functools import partial
 
 import jax
@@ -48,6 +50,7 @@ import jax.numpy as jnp
 import numpy as np
 from jax.sharding import Mesh, NamedSharding, PartitionSpec as P
 
+from ignjax.devices import available_cores
 from ignjax.errors import ConfigError
 from ignjax.sim import env as E
 from ignjax.sim import types as T
@@ -245,10 +248,13 @@ def _sharded(fn, world, specs, agent, params, keys, chunk, parts: int, copies: i
     of ``specs`` and ``keys`` split over ``parts`` devices, each episode run
     ``copies`` times (a sweep's settings). The episodes are padded with
     finished copies to ``parts`` equal shards (:func:`_shard_rows`); the
-    outputs' episode axis is ``out_axis``, and the padding is cut from it."""
+    outputs' episode axis is ``out_axis``, and the padding is cut from it.
+    A program compiled ahead for arguments like these (:func:`compile_ahead`)
+    is the one that runs."""
     n = specs.scene.shape[0]
     args, static, size = _sharded_args(fn, world, specs, agent, params, keys, chunk, parts, copies, out_axis)
-    out = _run_sharded(*args, **static)
+    ahead = _AHEAD.get(_program_key(args, static)) if _AHEAD else None
+    out = ahead(*args) if ahead is not None else _run_sharded(*args, **static)
     if size == n:
         return out
     return jax.tree.map(lambda a: jax.lax.slice_in_dim(a, 0, n, axis=out_axis), out)
@@ -262,6 +268,66 @@ def _run_sharded(world, specs, params, keys, *, fn, agent, widths, mesh: Mesh, o
     run = jax.shard_map(lambda w, s, p, k: fn(w, s, agent, p, k, widths), mesh=mesh,
                         in_specs=(P(), rows, P(), rows), out_specs=out, check_vma=False)
     return run(world, specs, params, keys)
+
+
+AHEAD_KEPT = 16
+"""Programs compiled ahead that a process keeps (:func:`compile_ahead`), the latest compiled."""
+_AHEAD: OrderedDict = OrderedDict()
+
+
+def _program_key(args, static: dict) -> tuple:
+    """What makes :func:`_run_sharded` another program: its static arguments, the arguments' tree and each
+    leaf's shape, dtype and placement."""
+    leaves, tree = jax.tree.flatten(args)
+    return (tuple(static[k] for k in sorted(static)), tree,
+            tuple((np.shape(x), str(getattr(x, "dtype", type(x))), getattr(x, "sharding", None)) for x in leaves))
+
+
+def rollout_call(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.Array, chunk: int | None = None,
+                 parts: int | None = None, sweep: bool = False) -> tuple:
+    """The program :func:`rollout` (with ``sweep``, :func:`rollout_sweep`,
+    ``params`` with a leading K axis) runs for these arguments, as
+    ``(arguments, static arguments)`` for :func:`compile_ahead`."""
+    n = specs.scene.shape[0]
+    keys = _keys(keys, n)
+    fn, copies, out_axis = (_rollout_sweep, jax.tree.leaves(params)[0].shape[0], 1) if sweep else (_rollout, 1, 0)
+    args, static, _ = _sharded_args(fn, world, specs, agent, params, keys, chunk, batch_parts(n, parts), copies,
+                                    out_axis)
+    return args, static
+
+
+def compile_ahead(calls, workers: int | None = None) -> int:
+    """Compile the rollout programs of ``calls`` (:func:`rollout_call`) side
+    by side, one thread per core (``workers``): XLA compiles without holding
+    Python's lock, so a run of several programs (a sweep's agents and its
+    in-the-loop stage) pays for about one compile per core instead of one
+    after another. :func:`rollout` and :func:`rollout_sweep` then run these
+    programs for arguments of the same shapes; they are the programs a first
+    call would compile (the same lowering and compiler options, the same
+    persistent-cache entries), so results are the same bytes. A process keeps
+    the :data:`AHEAD_KEPT` latest.
+
+    Returns:
+        How many programs were compiled (those already kept are not).
+    """
+    todo = {}
+    for args, static in calls:
+        key = _program_key(args, static)
+        if key not in _AHEAD:
+            todo[key] = (args, static)
+    if not todo:
+        return 0
+
+    def compile_one(item):
+        key, (args, static) = item
+        return key, _run_sharded.lower(*args, **static).compile()
+
+    with ThreadPoolExecutor(max(1, min(len(todo), workers or available_cores()))) as pool:
+        for key, program in pool.map(compile_one, todo.items()):
+            _AHEAD[key] = program
+            while len(_AHEAD) > AHEAD_KEPT:
+                _AHEAD.popitem(last=False)
+    return len(todo)
 
 
 def episode_keys(seed: int, indices) -> jax.Array:

@@ -41,7 +41,7 @@ from ignjax.episodes.schema import construction_path, read_episodes, write_recor
 from ignjax.errors import ConfigError, InputError
 from ignjax.evaluate.runner import BucketPlan, agent_batches, bucket_worlds, episode_batches, plan_run
 from ignjax.scenes.io.sources import scene_sources
-from ignjax.sim.rollout import batch_parts, rollout_sweep
+from ignjax.sim.rollout import batch_parts, compile_ahead, rollout_call, rollout_sweep
 from ignjax.sweep.checkpoints import Checkpoints, prepare_folder
 from ignjax.sweep.report import in_loop_costs, write_outputs
 
@@ -157,6 +157,23 @@ def _costs_params(cfg: SweepConfig, agent, costs):
     return dataclasses.replace(params, costs=jnp.asarray(costs, jnp.float32))
 
 
+def _stage_programs(es, world, work: dict, plans: dict, cfg: SweepConfig, c_agent, c_params) -> list:
+    """The rollout program of each stage with work in this bucket (:func:`ignjax.sim.rollout.rollout_call`, for
+    its first batch: every batch of a stage is the same program), so they compile side by side."""
+    calls = []
+    for stage, batches in work.items():
+        if not batches:
+            continue
+        _, specs, keys = next(episode_batches(es, plans[stage].batch, cfg.run.seed, select=[batches[0][1]]))
+        if stage == "costs/in_loop":
+            calls.append(rollout_call(world, specs, c_agent, c_params, keys, parts=cfg.eval.parts or None, sweep=True))
+        else:
+            agent = stage.split("/", 1)[1]
+            calls.append(rollout_call(world, specs, get_agent(agent), cfg.agents.make(agent, costs=cfg.eval.costs),
+                                      keys, parts=cfg.eval.parts or None))
+    return calls
+
+
 def rollout_stage_parts(bs: BenchmarkScenes, plans: dict, todo: dict, cfg: SweepConfig, store: PartStore):
     """This process's batches of the rollout stages, a bucket of scenes at a time
     (:func:`ignjax.evaluate.runner.bucket_worlds`), each written as a part file.
@@ -172,10 +189,12 @@ def rollout_stage_parts(bs: BenchmarkScenes, plans: dict, todo: dict, cfg: Sweep
     """
     parts = cfg.eval.parts or None
     seed = cfg.run.seed
+    c_agent = c_params = None
     if "costs/in_loop" in plans:
         costs, c_agent, _ = _costs_setup(cfg)
         c_params = _costs_params(cfg, c_agent, costs)
     for es, world, work in bucket_worlds(bs, plans, todo, cfg.sim):
+        compile_ahead(_stage_programs(es, world, work, plans, cfg, c_agent, c_params))
         for stage, batches in work.items():
             if not batches:
                 continue

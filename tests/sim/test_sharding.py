@@ -20,8 +20,11 @@ from ignjax.devices import ENV_VAR, configure_cpu_devices
 from ignjax.errors import ConfigError
 from ignjax.protocol import LOCKED_COSTS
 from ignjax.sim.compact import CHUNKS
+from ignjax.cache.clock import CompileClock
+from ignjax.sim import rollout as R
 from ignjax.sim.rollout import (
-    _shard_rows, _shard_widths, _widths, batch_parts, episode_keys, pad_specs, rollout, rollout_sweep,
+    _shard_rows, _shard_widths, _widths, batch_parts, compile_ahead, episode_keys, pad_specs, rollout, rollout_call,
+    rollout_sweep,
 )
 
 two_devices = pytest.mark.skipif(jax.device_count() < 2, reason=f"needs 2 devices (set {ENV_VAR}=2 or more)")
@@ -109,6 +112,27 @@ def test_rollout_on_two_devices_equals_one_device(small_benchmark, small_world, 
     assert one[0].steps.shape == (n,) and one[1].kind.shape[0] == n
     assert np.asarray(one[0].valid).all()  # no padding row in the result
     assert len(set(np.asarray(one[0].steps).tolist())) > 3  # the episodes differ: a shuffle would show
+
+
+@two_devices
+def test_programs_compiled_ahead_are_the_ones_that_run_with_the_same_bytes(small_benchmark, small_world):
+    """compile_ahead compiles several rollout programs side by side; rollout then runs them (no compilation of its
+    own) and gives what it gives without them, bit for bit."""
+    specs, keys = _batch(small_benchmark["set"], 40)
+    agent = get_agent("naive_asker")
+    params = agent.default_params()
+    R._run_sharded.clear_cache()  # so a call that did not run a program compiled ahead would have to obtain one
+    calls = [rollout_call(small_world, specs, agent, params, keys, parts=p) for p in (1, 2)]
+    compile_ahead(calls)
+    assert compile_ahead(calls) == 0  # both kept: nothing compiled again
+    clock = CompileClock().start()
+    ahead = [_host(rollout(small_world, specs, agent, params, keys, parts=p)) for p in (1, 2)]
+    clock.stop()
+    assert "jit(_run_sharded)" not in clock.names, "rollout obtained a program instead of running the one compiled ahead"
+    R._AHEAD.clear()
+    plain = [_host(rollout(small_world, specs, agent, params, keys, parts=p)) for p in (1, 2)]
+    for a, b in zip(ahead, plain):
+        chex.assert_trees_all_equal(a, b)
 
 
 @two_devices
