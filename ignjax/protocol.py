@@ -13,7 +13,10 @@ they are passed as configuration everywhere else.
   easy ``D < 0.30``, medium ``D < 0.60``, hard otherwise; the evaluation
   subset is sampled 30:40:30.
 * Views: ``N_VIEWS`` first-person views, view ``k`` at relative yaw
-  ``+45 degrees * k`` (counter-clockwise, so 2 is left).
+  ``+45 degrees * k`` (counter-clockwise, so 2 is left), each ``VIEW_HFOV``
+  = 90 degrees wide, so neighbours overlap by half (the paper's main
+  setting). The observation ablation's 4 and 12 views tile the circle
+  instead, ``360 / n`` degrees each (:func:`view_hfov`).
 """
 
 from __future__ import annotations
@@ -58,6 +61,29 @@ BIN_INDEX = {name: i for i, name in enumerate(BIN_NAMES)}
 N_VIEWS = 8
 VIEW_NAMES: tuple[str, ...] = ("front", "front-left", "left", "rear-left", "rear", "rear-right", "right", "front-right")
 """View ``k`` of the 8-view panel looks along ``yaw + k * 45 degrees``."""
+VIEW_HFOV = 90.0
+"""Horizontal field of view of each of the 8 views, degrees (the paper's "90 degree Field-of-View RGB view",
+centres 45 degrees apart: neighbours overlap by half)."""
+VIEW_COUNTS: tuple[int, ...] = (4, 8, 12)
+"""Panel sizes: 8 (the paper's main setting) and the observation ablation's 4 and 12."""
+
+
+def view_hfov(n_views: int, hfov8: float = VIEW_HFOV) -> float:
+    """Horizontal field of view of each view of an ``n_views`` panel, degrees.
+
+    8 views are ``hfov8`` wide each (the paper's 90 degrees; they overlap).
+    4 and 12 views tile the circle: ``360 / n_views`` each, so 4 views are
+    90 degrees (the paper's "4 views (90 degrees only)") and 12 views are
+    30 degrees (its "12 narrow views": "each view becomes narrower"); the
+    right edge of view k is the left edge of view k - 1, with no overlap and
+    no gap. Our reading: the paper gives no width for its narrow views, and
+    360 / 12 is the width at which 12 views cover the circle exactly once,
+    as its 4 views do.
+    """
+    if isinstance(n_views, bool) or n_views not in VIEW_COUNTS:
+        raise ValueError(f"n_views must be one of {VIEW_COUNTS}, got {n_views!r}")
+    return float(hfov8) if n_views == N_VIEWS else 360.0 / n_views
+
 GRID_CELLS = 8
 """The Grounder's grid is GRID_CELLS x GRID_CELLS: columns 1..8 left to right, rows 1..8 bottom to top."""
 
@@ -65,5 +91,5 @@ __all__ = [
     "QUESTION_TYPES", "N_QUESTION_TYPES", "TYPE_LABELS", "LOCKED_COSTS", "SUCCESS_THRESHOLDS", "SUCCESS_REQUIRES_STOP", "MAX_STEPS",
     "MAX_QUESTIONS", "COLLISION_DISTANCE", "HINT_LOOKAHEAD", "CONFIRM_RANGE", "DIFFICULTY_ALPHA",
     "DIFFICULTY_THRESHOLDS", "SUBSET_PROPORTIONS", "FACTOR_NAMES", "BIN_NAMES", "BIN_INDEX", "N_VIEWS", "VIEW_NAMES",
-    "GRID_CELLS",
+    "VIEW_HFOV", "VIEW_COUNTS", "view_hfov", "GRID_CELLS",
 ]

@@ -363,7 +363,7 @@ class HostLoop:
                 goal=vocab.category_display(rec["target_category"]), questions_left=int(qleft[r]),
                 costs=self.costs, answers=tuple(ep.answers),
                 last_move=" ".join(t for t in (_last_move_text(obs, r, last_kind), ep.progress) if t),
-                n_views=self.sim.n_views, observation=text, percept=percept)})
+                n_views=self.sim.n_views, view_fov=self.sim.view_hfov, observation=text, percept=percept)})
         return out
 
     def _decisions(self, items: list[dict], slots) -> list[tuple[int, Decision]]:
@@ -726,7 +726,8 @@ def dry_run(agent: LLMAgent, n_episodes: int, *, sim: T.SimConfig = T.SimConfig(
     two_stage = bool(getattr(agent, "two_stage", False)) and agent.observation == "panel"
     img = ImagePart(b"\xff\xd8\xff\xd9") if agent.observation == "panel" else None
     d = Decision(episode="dry-run", step=0, max_steps=sim.max_steps, goal="object", questions_left=sim.max_questions,
-                 costs=tuple(costs), answers=(), last_move="", n_views=sim.n_views, panel=img,
+                 costs=tuple(costs), answers=(), last_move="", n_views=sim.n_views, view_fov=sim.view_hfov,
+                 panel=img,
                  observation=None if img is not None else "\n".join(f"- view {k}: open floor for about 2.0 m; nothing of "
                                                                      "note" for k in range(sim.n_views)),
                  percept={})

@@ -21,13 +21,14 @@ from ignjax.sim.world import World
 
 
 def target_visible_front(world: World, ep: T.EpisodeSpec, pose):
-    """() bool: the target is in the front view's field of view, within
+    """() bool: the target is in the front view's field of view (the view's
+    own width, ``view_hfov``: 30 degrees with 12 narrow views), within
     ``confirm_range`` and in line of sight."""
     cfg = world.config
     inst = world.bank.instances
     c = inst.center[ep.scene, ep.target]
     rel = jnp.arctan2(c[1] - pose[1], c[0] - pose[0]) - pose[2]
-    in_fov = jnp.abs(G.wrap_angle(rel)) <= math.radians(cfg.hfov) / 2
+    in_fov = jnp.abs(G.wrap_angle(rel)) <= math.radians(cfg.view_hfov) / 2
     close = euclidean_to_target(world, ep, pose[:2]) <= cfg.confirm_range
     eye = jnp.array([pose[0], pose[1], cfg.eye_height], jnp.float32)
     seen = instance_in_sight(world, ep.scene, ep.target, eye)

@@ -58,14 +58,20 @@ class SimConfig:
         max_micro_steps: micro-steps per MOVE.
         eye_height: camera height, m.
         image_size: (W, H) of a view, pixels (for the grid-to-pixel map).
-        hfov: horizontal field of view of a view, degrees.
+        hfov: horizontal field of view of each of the 8 views, degrees
+            (the paper's 90: neighbours overlap by half). 4 and 12 views
+            tile the circle instead, 360 / n_views degrees each
+            (``view_hfov``), so with them this must stay 90. The symbolic observation's 8 sectors are this wide
+            whatever ``n_views`` is.
         n_views: views of the egocentric panel (4, 8 or 12); a MOVE's
             ``direction`` k means view k, along ``heading + k * 360 / n_views``
-            degrees (counter-clockwise). The paper's agents use 8; 4 and 12
-            are its observation ablation. The symbolic observation keeps its
-            8 sectors whatever this is, and the built-in JAX agents plan
-            with 8 views (:func:`ignjax.evaluate.runner.run_agent` refuses
-            another value for them).
+            degrees (counter-clockwise), ``view_hfov`` degrees wide (90 with
+            4 and 8 views, 30 with 12). The paper's
+            agents use 8; 4 and 12 are its observation ablation. The
+            symbolic observation keeps its 8 sectors whatever this is, and
+            the built-in JAX agents plan with 8 views
+            (:func:`ignjax.evaluate.runner.run_agent` refuses another value
+            for them).
         depth_range: longest valid depth of a pixel ray, m.
         pullback: distance the waypoint is pulled back from a hit surface, m.
         waypoint_tolerance: a waypoint closer than this is reached, m.
@@ -153,8 +159,12 @@ class SimConfig:
             raise ConfigError(None, "sim.image_size", f"must be [width, height] in pixels (>= 8), got {size!r}")
         if not 0 < self.hfov < 180:
             raise ConfigError(None, "sim.hfov", f"must lie in (0, 180) degrees, got {self.hfov}")
-        if isinstance(self.n_views, bool) or self.n_views not in (4, 8, 12):
+        if isinstance(self.n_views, bool) or self.n_views not in protocol.VIEW_COUNTS:
             raise ConfigError(None, "sim.n_views", f"must be 4, 8 or 12 views, got {self.n_views!r}")
+        if self.n_views != N_VIEWS and self.hfov != protocol.VIEW_HFOV:
+            raise ConfigError(None, "sim.hfov", f"sets the width of each of the 8 views; {self.n_views} views tile the "
+                              f"circle ({360 / self.n_views:g} degrees each), so it must stay {protocol.VIEW_HFOV:g} "
+                              f"with them, got {self.hfov}")
         if 0 < self.trace_len < self.max_steps:
             raise ConfigError(None, "sim.trace_len", f"must be >= max_steps ({self.max_steps}) to hold every question attempt")
         object.__setattr__(self, "collision_heights", tuple(float(h) for h in self.collision_heights))
@@ -175,6 +185,15 @@ class SimConfig:
         return {f.name: list(v) if isinstance(v := getattr(self, f.name), tuple) else v for f in dataclasses.fields(self)}
 
     @property
+    def view_hfov(self) -> float:
+        """Horizontal field of view of each view of the panel, degrees
+        (:func:`ignjax.protocol.view_hfov`): ``hfov`` for 8 views, 360 / n for
+        4 and 12 (views that tile the circle). The renderers' cameras, the
+        executor's back-projection of a grid cell and the oracle's "in the
+        front view" test all use it."""
+        return protocol.view_hfov(self.n_views, self.hfov)
+
+    @property
     def trace_slots(self) -> int:
         """Slots of the question trace: ``trace_len``, or ``max_steps`` when it is 0."""
         return self.trace_len or self.max_steps
@@ -189,7 +208,7 @@ class Action:
 
     Attributes:
         kind: () MOVE / ASK / STOP.
-        direction: () view 0..7 (relative yaw +45 deg * k) for MOVE.
+        direction: () view 0..n_views-1 (relative yaw k * 360 / n_views deg; 45 deg * k with 8) for MOVE.
         col: () grid column 1..8 (left to right) for MOVE.
         row: () grid row 1..8 (bottom to top) for MOVE.
         question: () question type 1..4 for ASK.

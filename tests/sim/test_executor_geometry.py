@@ -8,7 +8,11 @@ floor plane and the navigation grid) on a hand-made room:
 * the local controller moves in micro-steps of at most ``micro_step``
   (0.5 m); an obstacle within ``collision_distance`` (0.6 m) blocks a heading,
   which is recorded in ``SimState.blocked``, and one beyond it does not;
-* the agent is on a navigable cell after every micro-step.
+* the agent is on a navigable cell after every micro-step;
+* the views' fields of view: 4 and 12 views tile the circle (90 and 30
+  degrees, each edge ray shared with the neighbour), 8 views are 90 degrees
+  wide and overlap by half; the oracle's "in the front view" test uses the
+  front view's own width.
 
 The room: 8 x 4 m (walls 0.1 m thick, inner faces at x = 0.05 / 7.95 and
 y = 0.05 / 3.95), a low crate (top at 0.3 m) at x 3.8..4.2, y 1.6..2.4, a
@@ -28,10 +32,12 @@ import mujoco
 import numpy as np
 import pytest
 
+from ignjax.errors import ConfigError
 from ignjax.scenes.bank import SceneBank, target_fields
 from ignjax.scenes.model import Geom, Instance, OrientedBox, Room, Scene, SceneMeta, Wall
 from ignjax.sim import env as E
 from ignjax.sim import executor as X
+from ignjax.sim import geometry as G
 from ignjax.sim import types as T
 from ignjax.sim.world import World
 
@@ -342,3 +348,80 @@ def test_alternatives_probed_in_order_equal_probing_all_seven(room, chunk):
     assert (want_k > 1).sum() >= 10 and (np.asarray(need) & ~ok.any(1)).sum() >= 1  # later alternatives, and none
     np.testing.assert_array_equal(np.asarray(k), want_k)
     np.testing.assert_array_equal(np.asarray(full), want_full)
+
+
+# ---------------------------------------------------------------------------
+# the views' fields of view
+# ---------------------------------------------------------------------------
+
+
+def _edge_rays(cfg: T.SimConfig, yaw: float, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """Unit world directions of the left and right image edges of view ``k``
+    (pixel columns u = 0 and u = W at the optical centre's row), through the
+    executor's own camera (:func:`ignjax.sim.executor.view_camera`)."""
+    W, H = cfg.image_size
+    K, R_wc, _ = X.view_camera(cfg, jnp.array([0.0, 0.0, yaw], jnp.float32), jnp.int32(k))
+    rays = []
+    for u in (0.0, float(W)):
+        d = np.asarray(G.matvec3(R_wc, G.pixel_ray(K, jnp.array([u, H / 2], jnp.float32))), np.float64)
+        rays.append(d / np.linalg.norm(d))
+    return rays[0], rays[1]
+
+
+def _angle(a: np.ndarray, b: np.ndarray) -> float:
+    return math.degrees(math.acos(float(np.clip(a @ b, -1.0, 1.0))))
+
+
+@pytest.mark.parametrize("n_views, fov", [(4, 90.0), (12, 30.0)])
+def test_four_and_twelve_views_tile_the_circle(n_views, fov):
+    """Each view is 360 / n degrees wide, the widths sum to 360, and the left
+    edge ray of view k (views run counter-clockwise) is the right edge ray of
+    view k + 1: no overlap and no gap between neighbours."""
+    cfg = T.SimConfig(n_views=n_views)
+    assert cfg.view_hfov == fov
+    yaw = 0.4
+    widths = []
+    for k in range(n_views):
+        left, right = _edge_rays(cfg, yaw, k)
+        widths.append(_angle(left, right))
+        _, right_of_next = _edge_rays(cfg, yaw, (k + 1) % n_views)
+        np.testing.assert_allclose(left, right_of_next, atol=1e-6)
+    np.testing.assert_allclose(widths, fov, atol=1e-3)
+    assert sum(widths) == pytest.approx(360.0, abs=1e-2)
+
+
+def test_eight_views_stay_ninety_degrees_and_overlap_by_half():
+    """The paper's main setting, unchanged: 90-degree views 45 degrees apart,
+    so the right edge of view k + 1 lies on view k's optical axis."""
+    cfg = T.SimConfig()
+    assert cfg.n_views == 8 and cfg.view_hfov == cfg.hfov == 90.0
+    for k in range(8):
+        left, right = _edge_rays(cfg, -1.1, k)
+        assert _angle(left, right) == pytest.approx(90.0, abs=1e-3)
+        _, right_of_next = _edge_rays(cfg, -1.1, (k + 1) % 8)
+        axis = np.array([math.cos(-1.1 + k * math.pi / 4), math.sin(-1.1 + k * math.pi / 4), 0.0])
+        np.testing.assert_allclose(right_of_next, axis, atol=1e-6)
+
+
+def test_the_hfov_setting_belongs_to_the_eight_views():
+    with pytest.raises(ConfigError, match="sim.hfov"):
+        T.SimConfig(n_views=12, hfov=80.0)
+    assert T.SimConfig(hfov=80.0).view_hfov == 80.0 and T.SimConfig(n_views=4).view_hfov == 90.0
+
+
+def test_the_oracle_sees_in_front_with_the_front_views_width(room):
+    """The crate 2 m ahead, 25 degrees left of the heading: in the front view
+    of 8 (90 degrees wide) but not of 12 (30 degrees); 10 degrees left: in both."""
+    from types import SimpleNamespace
+
+    from ignjax.sim.oracle import target_visible_front
+
+    bank = room["bank"]
+    ep = SimpleNamespace(scene=jnp.int32(0), target=jnp.int32(0))
+    seen = {}
+    for n_views in (8, 12):
+        world = World(bank, room["world"].fields, T.SimConfig(n_views=n_views))
+        for deg in (25.0, 10.0):
+            pose = jnp.array([2.0, LANE_Y, -math.radians(deg)], jnp.float32)
+            seen[n_views, deg] = bool(target_visible_front(world, ep, pose))
+    assert seen == {(8, 25.0): True, (8, 10.0): True, (12, 25.0): False, (12, 10.0): True}

@@ -127,13 +127,15 @@ def test_every_sim_field_and_agent_parameter_is_a_config_key():
     of sweeps/default.toml."""
     changed = {"max_steps": 24, "max_questions": 7, "horizon": 2.5, "collision_distance": 0.5,
                "collision_heights": [0.2, 0.9], "micro_step": 0.4, "max_micro_steps": 6, "eye_height": 1.1,
-               "image_size": [320, 240], "hfov": 80.0, "n_views": 12, "depth_range": 8.0, "pullback": 0.25, "waypoint_tolerance": 0.2,
+               "image_size": [320, 240], "hfov": 90.0, "n_views": 12, "depth_range": 8.0, "pullback": 0.25, "waypoint_tolerance": 0.2,
                "hint_lookahead": 3.0, "confirm_range": 2.5, "stop_radius": 0.8, "hint_reached": 0.7,
                "obs_rays_per_view": 4, "obs_range": 5.0, "max_visible": 12, "trace_len": 30, "question_budget": False,
                "upfront_description": True, "miss_rate": 0.2, "confusion_rate": 0.1}
     assert set(changed) == {f.name for f in dataclasses.fields(SimConfig)}, "add the new SimConfig field here"
     cfg = resolve(None, [f"sim.{k}={json.dumps(v)}" for k, v in changed.items()])
     assert cfg.sim.to_dict() == changed and cfg.to_dict()["sim"] == changed
+    # hfov sets the width of the 8 views (12 views tile the circle, so it keeps its default above)
+    assert resolve(None, ["sim.hfov=80.0"]).to_dict()["sim"]["hfov"] == 80.0
     for name, agent in registry().items():
         for key, value in param_values(agent).items():
             new = (not value) if isinstance(value, bool) else (value + 1 if not isinstance(value, tuple) else value)

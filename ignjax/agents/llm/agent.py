@@ -38,6 +38,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ignjax.agents.llm.client import ChatRequest, ImagePart
+from ignjax.protocol import view_hfov
 from ignjax.sim.views.compose import view_names
 
 MOVE, ASK, STOP = 0, 1, 2
@@ -87,6 +88,9 @@ class Decision:
         answers: the oracle's answers so far, in order, as ``(type, text)``.
         last_move: what the executor reported about the last MOVE ("" at the start).
         n_views: views in the panel.
+        view_fov: horizontal field of view of each view, degrees (the
+            simulator's ``view_hfov``; 0: the default for ``n_views``, 90
+            for 4 and 8 views, 30 for 12).
         panel: the Planner panel, encoded (None for text observations).
         observation: the symbolic observation as text (None with a panel).
         views: the rendered views, (N, S, S, 3) uint8, for agents that show
@@ -118,6 +122,11 @@ class Decision:
     observation: str | None = None
     views: object = None
     percept: dict = field(default_factory=dict)
+    view_fov: float = 0.0
+
+    def __post_init__(self):
+        if not self.view_fov:  # the panel's own width (:func:`ignjax.protocol.view_hfov`)
+            object.__setattr__(self, "view_fov", view_hfov(self.n_views))
 
 
 @dataclass

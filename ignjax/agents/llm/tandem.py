@@ -3,11 +3,13 @@ baselines of Table 1 as configurations of one machinery.
 
 One decision of :class:`Tandem`:
 
-1. **Controller first** (host code, no model call) when a safeguard settles
-   the decision: after a "yes" to a confirmation question with the follow-up
-   "stop now", STOP; the recovery rule (several moves without any route hint
-   and without a confirmed candidate, questions left) asks a route question
-   (Type 3).
+1. **Controller first** (host code, no model call) when a rule settles
+   the decision (:mod:`ignjax.agents.llm.controller`): after a "yes" to a
+   confirmation question with the follow-up "stop now", STOP; the paper's
+   early-question schedule (one of Type 1/2 by the second decision, both by
+   the fifth) asks a missing one; the recovery rule (several moves without
+   a route hint while nothing the agent knows places it near the goal,
+   questions left) asks a route question (Type 3).
 2. **Planner** (one request): the instruction, the N-view panel (or, for the
    text-only baseline, each view described from the simulator's perception),
    the Fact Base (the oracle's answers, by type), the active route hint and
@@ -22,19 +24,19 @@ One decision of :class:`Tandem`:
    question's text goes to the decision's transcript record
    (``ctx.note_question``; none when the controller asks on its own), where
    the Type-3 content analysis reads it.
-3. **Controller checks** on the Planner's decision; a decision that breaks
-   a rule is answered with a correction and asked again (counted as an
+3. **Controller checks** on the Planner's decision
+   (:mod:`ignjax.agents.llm.controller`); a decision that breaks a rule is
+   answered with a correction (:data:`~ignjax.agents.llm.controller.CORRECTIONS`,
+   which say only what the agent could know) and asked again (counted as an
    invalid reply, like a malformed one): a Type-1/2 question whose fact is
    already in the Fact Base (safeguard 1); a route question where none of
-   its triggers holds — a branch (three or more open directions), a loop
-   (back within a metre of an earlier position), a long corridor, or the
-   goal room known while the agent is elsewhere (safeguard 2); any question,
-   or a move that is not toward the front half, while the follow-up asks
-   for "one closer move" (safeguard 3); a second backward move in a row
-   when the last was not blocked (anti-oscillation). A STOP without
-   evidence (no confirmed target, no hint saying the target is near) is
-   turned into a confirmation question when questions are left (the stop
-   policy: confirm before stopping).
+   its triggers holds (safeguard 2); any question, or a backward move,
+   while the follow-up asks for "one closer move" (safeguard 3); a second
+   backward move in a row when the last was not blocked (anti-oscillation).
+   Every STOP without evidence (no confirmed target, no hint saying the
+   target is near) is turned into a confirmation question when questions
+   are left (the stop policy: confirm before stopping); right after a "no"
+   with no move since, it is corrected instead.
 4. **Grounder** (one request, MOVE only): the selected view alone with its
    numbered 8x8 grid, the subgoal and the purpose; the reply is one cell
    (columns left to right, rows bottom to top; rows 1-3 for floor targets),
@@ -44,16 +46,20 @@ One decision of :class:`Tandem`:
 The prompts are ours, written to the paper's structure (role and
 observation; memory and interaction; question, hint and recovery policies;
 output contract; runtime state). Everything numeric the controller reads
-(free space per sector, odometry for loops, room codes) comes from
+(free space per sector, odometry for loops) comes from
 :attr:`~ignjax.agents.llm.agent.Decision.percept` and never reaches the
-model as a number.
+model as a number; where the agent is by room, the controller takes from
+the Planner's own belief updates, and the goal room from the oracle's
+Type-2 answer.
 
 Variants (:data:`TANDEM_AGENTS`, README "MLLM agents"): ``tandem``;
 ``tandem-no-spmem`` (no Spatial Memory: belief updates dropped, the memory
 block not shown); ``tandem-no-qa`` (never asks; the target's full
 description given at reset, as the paper's QA-off row); ``tandem-no-spmem-no-qa``;
 ``tandem-naive`` (no costs shown, no safeguards: the naive-QA protocol);
-``tandem-4v`` / ``tandem-12v`` (the observation ablation: 4 or 12 views).
+``tandem-4v`` / ``tandem-12v`` (the observation ablation: 4 views of 90
+degrees or 12 narrow views of 30, each set tiling the circle;
+:func:`ignjax.protocol.view_hfov`).
 Baselines in the style of the paper's adaptations (our reading of each, on
 this machinery; the paper's own code is not used): ``gta``
 (Planner-Grounder without Spatial Memory), ``coin`` (no route questions),
@@ -66,27 +72,15 @@ and a naive-QA form (``-naive``).
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, field
-
 from ignjax.agents.llm.agent import ASK, MOVE, MOVED_M, QUESTION_HELP, QUESTION_NAMES, STOP, Decision, LLMAgent
 from ignjax.agents.llm.client import ChatRequest
+from ignjax.agents.llm.controller import RECOVERY_MOVES, TEXT_CHARS, TandemController, TandemMemory, clip, rear
 from ignjax.sim import types as T
 from ignjax.sim.views.compose import view_names
 
 PHASES = ("explore", "verify", "approach", "recover")
-OPEN_M = 1.5
-"""A sector counts as an open direction when its free floor reaches this far (m)."""
-LOOP_M = 1.0
-"""Back within this distance of a position of two or more decisions ago: a loop (m)."""
-CORRIDOR_M = 3.0
-"""Long corridor: front and rear open past this, both sides closed (m)."""
-RECOVERY_MOVES = 5
-"""Moves without a route hint and without a confirmed candidate before the recovery rule asks one."""
 MEMORY_ITEMS = 6
 """Entries kept per Spatial Memory list."""
-TEXT_CHARS = 160
-"""Longest text kept from one belief-update entry."""
 GROUNDER_FALLBACK = (4, 2)
 """Cell taken when no Grounder reply is usable: centre column, near floor."""
 
@@ -142,29 +136,6 @@ GROUNDER_SCHEMA = {
 }
 
 
-@dataclass
-class TandemMemory:
-    """One episode's host-side state: Spatial Memory, Fact Base, history."""
-
-    current_room: str = "unknown"
-    target_description: str = "unknown"
-    visited: list = field(default_factory=list)
-    unexplored: list = field(default_factory=list)
-    observations: list = field(default_factory=list)
-    places: list = field(default_factory=list)  # map-like memory (mapgpt): "step k: place"
-    moves: list = field(default_factory=list)  # (step, direction name, subgoal, rear-family, outcome)
-    history: list = field(default_factory=list)  # (step, kind, action, reason): LLMAgent's record
-    positions: list = field(default_factory=list)  # odometry (x, y) per decision
-    last_purpose: str = ""
-    questions: list = field(default_factory=list)  # (step, type, question text)
-    candidates: list = field(default_factory=list)  # Type-4 outcomes in words
-    moves_since_hint: int = 0
-
-
-def _clip(text, n: int = TEXT_CHARS) -> str:
-    return " ".join(str(text or "").split())[:n]
-
-
 def _cell(parsed, err):
     """``((col, row), None)`` from a reply's grid cell, or ``(None, why)``."""
     if parsed is None:
@@ -176,12 +147,7 @@ def _cell(parsed, err):
     return (parsed["col"], parsed["row"]), None
 
 
-def _rear(k: int, n: int) -> bool:
-    a = (360.0 * k / n) % 360.0
-    return 90.0 < a < 270.0
-
-
-class Tandem(LLMAgent):
+class Tandem(TandemController, LLMAgent):
     """TANDEM and its variants (module docstring).
 
     Args:
@@ -189,8 +155,10 @@ class Tandem(LLMAgent):
         qa: the agent may ask questions (False: the target's full description
             is given at reset, ``sim.upfront_description``).
         cost_aware: the prompt shows each question type's cost.
-        safeguards: the controller's four safeguards, anti-oscillation and the
-            stop policy (False: the naive protocol, every decision the model's).
+        safeguards: the controller's four safeguards, the early-question
+            schedule, anti-oscillation and the stop policy
+            (:mod:`ignjax.agents.llm.controller`; False: the naive protocol,
+            every decision the model's).
         two_stage: a Grounder picks the cell (False: the Planner picks it).
         route_questions: Type 3 may be asked (False: COIN-style).
         memory_style: ``"spatial"`` (the paper's fields) or ``"map"``
@@ -238,93 +206,12 @@ class Tandem(LLMAgent):
     def start(self, episode: str) -> TandemMemory:
         return TandemMemory()
 
-    # -- controller --------------------------------------------------------
-    def _route_triggers(self, m: TandemMemory, d: Decision) -> list[str]:
-        p = d.percept
-        opened = [float(x) >= OPEN_M for x in p.get("open", [])]
-        out = []
-        if sum(opened) >= 3:
-            out.append("branch")
-        pos = p.get("odometry")
-        if pos is not None and any(math.dist(pos, q) < LOOP_M for q in m.positions[:-2]):
-            out.append("loop")
-        free = p.get("open", [])
-        if len(free) == 8 and min(free[0], free[4]) >= CORRIDOR_M and max(free[2], free[6]) < OPEN_M:
-            out.append("corridor")
-        if p.get("goal_room", -1) >= 0 and p.get("room", -1) != p.get("goal_room"):
-            out.append("goal room elsewhere")
-        return out
-
-    def _controller(self, m: TandemMemory, d: Decision):
-        """An action the controller takes without asking the model, or None."""
-        p = d.percept
-        if not self.safeguards:
-            return None
-        if p.get("follow_up") == T.FOLLOW_STOP_NOW and p.get("confirm") == 1:
-            return (STOP, 0, 4, 1, 1)
-        if (self.qa and self.route_questions and d.questions_left > 0 and m.moves_since_hint >= RECOVERY_MOVES
-                and not p.get("hint_active") and p.get("confirm") != 1):
-            m.moves_since_hint = 0
-            return (ASK, 0, 4, 1, 3)
-        return None
-
-    def _check(self, m: TandemMemory, d: Decision, parsed: dict):
-        """``(action, None)`` or ``(None, why)`` for a Planner decision (module docstring, step 3)."""
-        names = view_names(d.n_views)
-        a = parsed.get("action")
-        p = d.percept
-        known = p.get("known", [False] * 4)
-        follow = p.get("follow_up") == T.FOLLOW_ONE_MOVE and p.get("confirm") == 1
-        if a == "ask":
-            t = parsed.get("question_type")
-            if not self.may_ask:
-                return None, "questions are not available to you; choose move or stop"
-            if not isinstance(t, int) or isinstance(t, bool) or not 1 <= t <= 4:
-                return None, "field 'question_type' must be an integer from 1 to 4"
-            if t == 3 and not self.route_questions:
-                return None, "route questions (type 3) are not available to you; ask another type or move"
-            if d.questions_left <= 0:
-                return None, "no questions are left; choose move or stop"
-            if self.safeguards:
-                if follow:
-                    return None, "the target is confirmed; make one closer move toward it, then stop"
-                if t in (1, 2) and known[t - 1]:
-                    return None, (f"the {QUESTION_NAMES[t]} fact is already in the Fact Base; use it instead of "
-                                  "asking again")
-                if t == 3 and not self._route_triggers(m, d):
-                    return None, ("a route question helps at a branch, after a loop, in a long corridor or when the "
-                                  "goal room is known but you are not in it; none applies here, so move or ask "
-                                  "another type")
-            return (ASK, 0, 4, 1, t), None
-        if a == "stop":
-            evidence = (p.get("confirm") == 1 or p.get("hint_progress") == T.HINT_STOP)
-            if self.safeguards and not evidence and self.may_ask and d.questions_left > 0 and not known[3]:
-                return (ASK, 0, 4, 1, 4), None  # confirm before stopping
-            return (STOP, 0, 4, 1, 1), None
-        if a == "move":
-            name = parsed.get("direction")
-            if name not in names:
-                return None, f"field 'direction' must be one of {', '.join(names)}"
-            k = names.index(name)
-            if not _clip(parsed.get("subgoal")):
-                return None, "a move needs a subgoal naming a place in that view"
-            if self.safeguards:
-                if follow and _rear(k, d.n_views):
-                    return None, "the target is confirmed ahead of you; move one step closer toward it, not backward"
-                last = m.moves[-1] if m.moves else None
-                if (_rear(k, d.n_views) and last is not None and last[3] and last[4] != "blocked"
-                        and not follow):
-                    return None, ("your last move already went backward; choose a front or side direction, or ask a "
-                                  "route question if you are unsure")
-            return (MOVE, k, 0, 0, 1), None
-        return None, "field 'action' must be one of move, ask, stop"
-
     # -- prompts -----------------------------------------------------------
     def planner_system(self, d: Decision) -> str:
         names = view_names(d.n_views)
         qtypes = [t for t in (1, 2, 3, 4) if self.route_questions or t != 3]
         costs = (lambda t: f" (costs {d.costs[t - 1]:.3f})") if self.show_costs else (lambda t: "")
-        see = (f"one image of {d.n_views} camera views around you, each 90 degrees wide and labelled with its "
+        see = (f"one image of {d.n_views} camera views around you, each {d.view_fov:g} degrees wide and labelled with its "
                f"direction ({', '.join(names)}), arranged as a map around a centre cell: front is up, left is left"
                if self.observation == "panel" else
                f"a written description of what each of your {d.n_views} directions shows ({', '.join(names)}); the "
@@ -348,19 +235,7 @@ class Tandem(LLMAgent):
                 + "\nEvery question lowers the final score" + (" by its cost" if self.show_costs else "")
                 + "; ask only when the answer changes your next decision, and never ask what the Fact Base already "
                 "says.")
-            blocks.append(
-                # block 3: question, hint and recovery policies
-                "Policies:\n"
-                "- Early on, while the Fact Base lacks the target's appearance or room, asking for them usually pays.\n"
-                + ("- A route question fits a junction with several plausible ways, a loop (you are back where you "
-                   "were), a long corridor, or a known goal room whose way in is unclear. While a route hint is "
-                   "active, use it as your main bias and choose short, reachable places on the hinted side; trust "
-                   "what you see if it contradicts the hint.\n" if self.route_questions else "")
-                + "- Ask for a confirmation when an object in front of you might be the target. After a yes with "
-                "'move closer', make exactly one move toward it and then stop; after a plain yes, stop.\n"
-                "- Stop only when the target is confirmed or a hint says you are close enough to it.\n"
-                "- Avoid going back and forth: backward directions are for recovery (dead end, wrong room); after one "
-                "backward move prefer a new front or side way.")
+            blocks.append(self.policies_text())  # block 3: question, hint and recovery policies
         else:
             blocks.append(
                 ("You keep a memory of the search (given back to you each turn) and update it in 'belief_update'.\n"
@@ -379,6 +254,26 @@ class Tandem(LLMAgent):
             "not an action like 'explore'), 'purpose' (why), 'question_type' (1-4) and 'question' (the question's "
             f"text){cell}. Keys your action does not use are ignored.")
         return "\n\n".join(blocks)
+
+    def policies_text(self) -> str:
+        """Block 3 of the Planner's system prompt: question, hint, stop and recovery policies."""
+        by_you = " (otherwise the controller asks for you)" if self.safeguards else ""
+        return (
+            "Policies:\n"
+            "- Early questions: while the Fact Base lacks the target's appearance or room, ask for them early: one of "
+            f"the two by your second turn and both by your fifth while questions remain{by_you}. Once the Fact Base "
+            "holds them, do not ask them again.\n"
+            + ("- A route question fits a junction with several plausible ways, a loop (you are back where you "
+               "were), a long corridor, or a known goal room whose way in is unclear. While a route hint is "
+               "active, use it as your main bias and choose short, reachable places on the hinted side; trust "
+               "what you see if it contradicts the hint.\n" if self.route_questions else "")
+            + "- Ask for a confirmation when an object in front of you might be the target. After a yes with "
+            "'move closer', make exactly one move toward it and then stop; after a plain yes, stop.\n"
+            "- Stop only when the target is confirmed or a hint says you are close enough to it"
+            + ("; a stop without that is turned into a confirmation question while questions remain" if self.safeguards
+               else "") + ".\n"
+            "- Avoid going back and forth: backward directions are for recovery (dead end, wrong room); after one "
+            "backward move prefer a new front or side way.")
 
     def memory_text(self, m: TandemMemory) -> str:
         if self.memory_style == "map":
@@ -450,10 +345,13 @@ class Tandem(LLMAgent):
 
     # -- memory updates ------------------------------------------------------
     def _merge(self, m: TandemMemory, d: Decision, parsed: dict) -> None:
-        m.last_purpose = _clip(parsed.get("purpose"))
+        m.last_purpose = clip(parsed.get("purpose"))
+        b = parsed.get("belief_update")
+        if isinstance(b, dict) and clip(b.get("current_room"), 80):
+            m.room_claim = clip(b.get("current_room"), 80)  # the controller's reading of where the agent thinks it is
         if self.memory_style == "map":
             b = parsed.get("belief_update") or {}
-            place = _clip(b.get("current_room") if isinstance(b, dict) else "", 80)
+            place = clip(b.get("current_room") if isinstance(b, dict) else "", 80)
             if place:
                 m.places.append(f"step {d.step}: {place}")
             return
@@ -462,14 +360,14 @@ class Tandem(LLMAgent):
         b = parsed.get("belief_update")
         if not isinstance(b, dict):
             return
-        if _clip(b.get("current_room")):
-            m.current_room = _clip(b.get("current_room"))
-        if _clip(b.get("target_description")):
-            m.target_description = _clip(b.get("target_description"))
+        if clip(b.get("current_room")):
+            m.current_room = clip(b.get("current_room"))
+        if clip(b.get("target_description")):
+            m.target_description = clip(b.get("target_description"))
 
         def items(key):
             v = b.get(key)
-            return [_clip(x) for x in v if _clip(x)] if isinstance(v, list) else []
+            return [clip(x) for x in v if clip(x)] if isinstance(v, list) else []
 
         m.visited = list(dict.fromkeys(m.visited + items("visited_areas")))[-MEMORY_ITEMS:]
         m.unexplored = items("unexplored_areas")[-MEMORY_ITEMS:] or m.unexplored
@@ -502,7 +400,7 @@ class Tandem(LLMAgent):
                 if act[0] == MOVE:
                     act = await self._ground(ctx, m, d, act, parsed)
                 elif act[0] == ASK and parsed.get("action") == "ask":  # not a stop turned into a confirmation
-                    question = _clip(parsed.get("question"))
+                    question = clip(parsed.get("question"))
         self._record(m, d, act, question)
         if act[0] == ASK and question:
             ctx.note_question(question)
@@ -525,7 +423,7 @@ class Tandem(LLMAgent):
         if not self.two_stage:
             return act
         k = act[1]
-        req = self.grounder_request(d, ctx.view_image(k), _clip(parsed.get("subgoal")), _clip(parsed.get("purpose")))
+        req = self.grounder_request(d, ctx.view_image(k), clip(parsed.get("subgoal")), clip(parsed.get("purpose")))
         got = await ctx.query(req, _cell, role="grounder")
         col, row = got if got is not None else GROUNDER_FALLBACK
         return (MOVE, k, col, row, 1)
@@ -536,7 +434,7 @@ class Tandem(LLMAgent):
         if not m.history or m.history[-1][0] != d.step:
             m.history.append((d.step, kind, act, ""))
         if act[0] == MOVE:
-            m.moves.append((d.step, names[act[1]], m.last_purpose and _clip(m.last_purpose, 60), _rear(act[1], d.n_views), ""))
+            m.moves.append((d.step, names[act[1]], m.last_purpose and clip(m.last_purpose, 60), rear(act[1], d.n_views), ""))
             m.moves_since_hint = 0 if d.percept.get("hint_active") else m.moves_since_hint + 1
         elif act[0] == ASK:
             m.questions.append((d.step, act[4], question))
@@ -587,4 +485,5 @@ TANDEM_AGENTS = {
 """The MLLM agents of Table 1 and the ablations, by name (module docstring)."""
 
 
-__all__ = ["GROUNDER_SCHEMA", "TANDEM_AGENTS", "Tandem", "TandemMemory", "one_stage_schema", "planner_schema"]
+__all__ = ["GROUNDER_SCHEMA", "RECOVERY_MOVES", "TANDEM_AGENTS", "Tandem", "TandemMemory", "one_stage_schema",
+           "planner_schema"]

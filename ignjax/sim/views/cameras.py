@@ -4,7 +4,13 @@ View k of N looks along ``yaw + k * 2 pi / N`` (counter-clockwise) from the
 eye ``(x, y, eye_height)`` with pitch 0, a pinhole of horizontal field of
 view ``hfov`` on a square image: exactly the camera
 :func:`ignjax.sim.executor.pixel_waypoint` back-projects a grid cell through
-(:func:`ignjax.sim.geometry.view_rotation`). MuJoCo's camera frame looks
+(:func:`ignjax.sim.executor.view_camera`). ``hfov`` is the simulator's
+``view_hfov`` (:func:`ignjax.protocol.view_hfov`): 90 degrees for 8 views
+(neighbours overlap by half, the paper's main setting) and ``360 / N`` for
+4 and 12, whose views tile the circle. A 12-view image is as large as an
+8-view one and covers 30 x 30 degrees: the same pixels over a narrower
+field, so at eye height 1.25 m its bottom edge meets the floor about 4.7 m
+ahead (the grid's floor rows lie beyond the executor's 3 m horizon). MuJoCo's camera frame looks
 along its -z axis with +y up, so its rotation's columns are (right, -down,
 -forward) of the executor's camera frame.
 

@@ -2,7 +2,7 @@
 choice of backend.
 
 The view geometry is the executor's and lives in :class:`ignjax.sim.types.SimConfig`
-(``n_views``, ``eye_height``, ``hfov``; pitch 0): a rendered view is exactly
+(``n_views``, ``eye_height``, ``view_hfov``; pitch 0): a rendered view is exactly
 the camera the executor back-projects a grid cell through. What is only
 about images lives here: their size, the backend, and how they are encoded.
 

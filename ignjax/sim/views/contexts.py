@@ -56,11 +56,11 @@ class SceneContexts:
         if self.backend == "egl":
             from ignjax.sim.views.egl import EglScene
 
-            r = EglScene(compiled, sim.n_views, sim.hfov, sim.eye_height, cfg.size)
+            r = EglScene(compiled, sim.n_views, sim.view_hfov, sim.eye_height, cfg.size)
         else:
             from ignjax.sim.views.warp import WarpScene
 
-            r = WarpScene(compiled, sim.n_views, sim.hfov, sim.eye_height, cfg.size, key[1])
+            r = WarpScene(compiled, sim.n_views, sim.view_hfov, sim.eye_height, cfg.size, key[1])
         self._scenes[key] = r
         self.made += 1
         return r

@@ -67,7 +67,7 @@ class ViewRenderer:
 
     Args:
         bank: the scene bank (its compiled scenes are rendered).
-        sim: the simulator configuration (``n_views``, ``hfov``, ``eye_height``).
+        sim: the simulator configuration (``n_views``, ``view_hfov``, ``eye_height``).
         config: image size, backend, workers and encoding (:class:`ViewConfig`).
     """
 

@@ -37,7 +37,7 @@ class WarpScene:
 
     Args:
         compiled: the scene as compiled for the simulator.
-        n_views, hfov_deg, eye_height: the views (SimConfig).
+        n_views, hfov_deg, eye_height: the views (SimConfig: ``hfov_deg`` is its ``view_hfov``).
         size: pixels per side.
         nworld: episodes per call (rows beyond it are rendered in further calls).
     """

@@ -9,6 +9,7 @@ oracle's route hints over 10,000 answers across the shipped scenes."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import re
 from pathlib import Path
@@ -21,9 +22,11 @@ from ignjax.agents.llm.agent import ASK, MOVE, STOP, Decision
 from ignjax.agents.llm.catalog import LLM_AGENTS, get_llm_agent
 from ignjax.agents.llm.config import LLMConfig
 from ignjax.agents.llm.serve import ScriptedServer, scripted_reply
+from ignjax.agents.llm.controller import CORRECTIONS
 from ignjax.agents.llm.tandem import RECOVERY_MOVES, TandemMemory
 from ignjax.episodes.dataset import load_benchmark
 from ignjax.evaluate.hostloop import run_llm_agent
+from ignjax.scenes import vocab
 from ignjax.sim import oracle_text as OT
 from ignjax.sim import types as T
 from ignjax.sim.views import ViewConfig
@@ -67,19 +70,24 @@ def test_type1_and_type2_only_while_the_fact_is_missing():
     assert naive._check(m, _decision(known=[True] * 4), _plan("ask", question_type=1))[0] == (ASK, 0, 4, 1, 1)
 
 
-@pytest.mark.parametrize("percept, allowed", [
-    ({}, False),
-    ({"open": [2.0, 2.0, 0.5, 0.5, 2.0, 0.5, 0.5, 0.5]}, True),  # branch: three open directions
-    ({"open": [4.0, 0.5, 0.5, 0.5, 4.0, 0.5, 0.5, 0.5]}, True),  # long corridor
-    ({"goal_room": 5, "room": 2}, True),  # the goal room is known and elsewhere
-    ({"goal_room": 2, "room": 2}, False),  # ... and here
+KITCHEN, OFFICE = vocab.ROOM_LABEL_INDEX["kitchen"], vocab.ROOM_LABEL_INDEX["office"]
+
+
+@pytest.mark.parametrize("percept, claim, allowed", [
+    ({}, "", False),
+    ({"open": [2.0, 2.0, 0.5, 0.5, 2.0, 0.5, 0.5, 0.5]}, "", True),  # branch: three open directions
+    ({"open": [4.0, 0.5, 0.5, 0.5, 4.0, 0.5, 0.5, 0.5]}, "", True),  # long corridor
+    ({"goal_room": OFFICE}, "", True),  # the oracle named the goal room; the agent does not say it is there
+    ({"goal_room": OFFICE, "room": KITCHEN}, "a small study with a desk", False),  # it believes it is there
+    # the gate reads the agent's belief, not the simulator's room code
+    ({"goal_room": OFFICE, "room": OFFICE}, "the kitchen", True),
 ])
-def test_route_questions_only_where_a_trigger_holds(percept, allowed):
+def test_route_questions_only_where_a_trigger_holds(percept, claim, allowed):
     a = get_llm_agent("tandem")
-    act, why = a._check(TandemMemory(), _decision(**percept), _plan("ask", question_type=3))
+    act, why = a._check(TandemMemory(room_claim=claim), _decision(**percept), _plan("ask", question_type=3))
     assert (act is not None) == allowed, why
     if not allowed:
-        assert "route question" in why
+        assert why == CORRECTIONS["route"]
 
 
 def test_route_question_after_a_loop():
@@ -101,25 +109,119 @@ def test_follow_up_after_a_yes():
     assert a._check(m, one, _plan("stop"))[0] == (STOP, 0, 4, 1, 1)  # confirmed: the stop has its evidence
 
 
-def test_stop_policy_confirms_before_stopping():
+def test_stop_policy_confirms_before_every_unconfirmed_stop():
     a = get_llm_agent("tandem")
     m = TandemMemory()
     assert a._check(m, _decision(), _plan("stop"))[0] == (ASK, 0, 4, 1, 4)
     assert a._check(m, _decision(hint_progress=T.HINT_STOP), _plan("stop"))[0] == (STOP, 0, 4, 1, 1)
     assert a._check(m, _decision(questions_left=0), _plan("stop"))[0] == (STOP, 0, 4, 1, 1)
-    assert a._check(m, _decision(known=[False, False, False, True]), _plan("stop"))[0] == (STOP, 0, 4, 1, 1)
     assert get_llm_agent("tandem-naive")._check(m, _decision(), _plan("stop"))[0] == (STOP, 0, 4, 1, 1)
+    # after a "no": a stop at the same place is corrected (asking again would get the same answer) ...
+    no = _decision(step=4, known=[True, True, False, True], confirm=0)
+    m = TandemMemory(questions=[(3, 4, "")], moves=[(1, "front", "", False, "moved")])
+    act, why = a._check(m, no, _plan("stop"))
+    assert act is None and why == CORRECTIONS["stop_after_no"]
+    m.moves.append((4, "left", "", False, "blocked"))  # a move that did not get anywhere changes nothing
+    assert a._check(m, no, _plan("stop"))[0] is None
+    # ... and after a move, the next stop is confirmed again: every stop, not only before the first Type 4
+    m.moves.append((5, "front", "", False, "moved"))
+    assert a._check(m, _decision(step=6, known=[True, True, False, True], confirm=0), _plan("stop"))[0] == (ASK, 0, 4, 1, 4)
 
 
-def test_recovery_rule_asks_for_a_route_hint():
+def test_recovery_rule_asks_for_a_route_hint_when_far_by_what_the_agent_knows():
     a = get_llm_agent("tandem")
     m = TandemMemory(moves_since_hint=RECOVERY_MOVES - 1)
-    assert a._controller(m, _decision()) is None
+    assert a._controller(m, _decision(known=[True, True, False, False])) is None
     m.moves_since_hint = RECOVERY_MOVES
-    assert a._controller(m, _decision(hint_active=True)) is None
-    assert a._controller(m, _decision(questions_left=0)) is None
-    assert a._controller(m, _decision()) == (ASK, 0, 4, 1, 3)
-    assert get_llm_agent("coin")._controller(TandemMemory(moves_since_hint=RECOVERY_MOVES), _decision()) is None
+    d = _decision(known=[True, True, False, False], goal_room=OFFICE, room=OFFICE)
+    assert a._controller(m, dataclasses.replace(d, percept={**d.percept, "hint_active": True})) is None
+    assert a._controller(m, dataclasses.replace(d, questions_left=0)) is None
+    # near the goal by what it knows: a confirmed target, a stop-eligible hint, or its own belief that it stands
+    # in the goal room the oracle named (the simulator's room code above says so too, and is not what counts)
+    assert a._controller(m, dataclasses.replace(d, percept={**d.percept, "confirm": 1})) is None
+    assert a._controller(m, dataclasses.replace(d, percept={**d.percept, "hint_progress": T.HINT_STOP})) is None
+    assert a._controller(TandemMemory(moves_since_hint=RECOVERY_MOVES, room_claim="the study"), d) is None
+    assert a._controller(TandemMemory(moves_since_hint=RECOVERY_MOVES, room_claim="a hallway"), d) == (ASK, 0, 4, 1, 3)
+    assert a._controller(m, d) == (ASK, 0, 4, 1, 3) and m.moves_since_hint == 0
+    coin = get_llm_agent("coin")
+    assert coin._controller(TandemMemory(moves_since_hint=RECOVERY_MOVES), _decision(known=[True] * 4)) is None
+
+
+@pytest.mark.parametrize("turn, asked, costs, want", [
+    (1, (), None, None),  # nothing is due at the first decision
+    (2, (), None, 2),  # one of Type 1/2 by the second: the cheaper at the locked costs (Type 2)
+    (2, (), (0.1, 0.2, 0.2, 0.1), 1),  # ... or under the costs in force
+    (2, (1,), None, None),
+    (4, (2,), None, None),
+    (5, (2,), None, 1),  # both by the fifth
+    (7, (1,), None, 2),  # still missing later: asked as soon as the controller may
+    (5, (1, 2), None, None),
+])
+def test_early_question_schedule(turn, asked, costs, want):
+    a = get_llm_agent("tandem")
+    known = [t in asked for t in (1, 2)] + [False, False]
+    d = _decision(step=turn - 1, known=known)
+    if costs is not None:
+        d = dataclasses.replace(d, costs=costs)
+    assert a._controller(TandemMemory(), d) == (None if want is None else (ASK, 0, 4, 1, want))
+    if want is not None:  # asked (a question in flight counts as asked), no budget, follow-up, naive, no QA: nothing
+        assert a._controller(TandemMemory(questions=[(0, want, "")]), d) is None
+        assert a._controller(TandemMemory(), dataclasses.replace(d, questions_left=0)) is None
+        assert a._controller(TandemMemory(), dataclasses.replace(
+            d, percept={**d.percept, "confirm": 1, "follow_up": T.FOLLOW_ONE_MOVE})) is None
+        for name in ("tandem-naive", "tandem-no-qa"):
+            assert get_llm_agent(name)._controller(TandemMemory(), d) is None
+
+
+def _secret_checks(text: str) -> list[str]:
+    """What a correction must not carry: a room's name, the agent's standing toward the goal room or the target,
+    a distance, an instance id."""
+    out = [f"room name {r!r}" for r in [vocab.ROOM_DISPLAY[label] for label in vocab.ROOM_LABELS] + ["study", "lounge"]
+           if re.search(rf"\b{r}\b", text, re.I)]
+    for name, pat in (("standing", r"\byou are (not |now |already )?(in|inside|near|close|far|next)\b|none applies|"
+                                   r"not in it|elsewhere|\bin the goal room"),
+                      ("distance", r"\d+(\.\d+)?\s*(m|cm|metres?|meters?)\b|\bmet(re|er)s?\b|distance|\bfar\b"),
+                      ("instance id", r"\bobject \d|\binstance|\bid\b|\bhandle")):
+        out += [f"{name}: {m.group(0)!r}" for m in re.finditer(pat, text, re.I)]
+    return out
+
+
+def test_corrections_tell_no_secrets():
+    """Every correction the controller can say, produced by a decision that earns it, under percepts full of ground
+    truth (the room the agent stands in, the goal room, free space, a position): the text is the catalogue's, says
+    nothing the agent was not told, and a refused route question reads the same whatever the ground truth."""
+    truth = {"room": OFFICE, "goal_room": OFFICE, "odometry": [3.5, -1.25], "open": [0.7] * 8}
+    rear_last = TandemMemory(moves=[(2, "rear", "", True, "moved")])
+    after_no = TandemMemory(questions=[(3, 4, "")])
+    yes_closer = {"confirm": 1, "follow_up": T.FOLLOW_ONE_MOVE}
+    cases = {
+        "action": ("tandem", TandemMemory(), {}, _plan("wander")),
+        "question_type": ("tandem", TandemMemory(), {}, _plan("ask", question_type=7)),
+        "direction": ("tandem", TandemMemory(), {}, _plan("move", direction="up")),
+        "subgoal": ("tandem", TandemMemory(), {}, _plan("move", subgoal="")),
+        "no_questions": ("tandem-no-qa", TandemMemory(), {}, _plan("ask", question_type=1)),
+        "no_route_questions": ("coin", TandemMemory(), {}, _plan("ask", question_type=3)),
+        "budget": ("tandem", TandemMemory(), {"questions_left": 0}, _plan("ask", question_type=2)),
+        "follow_up_ask": ("tandem", TandemMemory(), yes_closer, _plan("ask", question_type=4)),
+        "known_fact": ("tandem", TandemMemory(), {"known": [False, True, False, False]}, _plan("ask", question_type=2)),
+        "route": ("tandem", TandemMemory(room_claim="the office"), {}, _plan("ask", question_type=3)),
+        "follow_up_rear": ("tandem", TandemMemory(), yes_closer, _plan("move", direction="rear")),
+        "oscillation": ("tandem", rear_last, {}, _plan("move", direction="rear-right")),
+        "stop_after_no": ("tandem", after_no, {"confirm": 0, "step": 4}, _plan("stop")),
+    }
+    assert set(cases) == set(CORRECTIONS), "give every correction a case here"
+    for name, (agent, m, extra, plan) in cases.items():
+        step, left = extra.pop("step", 3), extra.pop("questions_left", 5)
+        act, why = get_llm_agent(agent)._check(m, _decision(step=step, questions_left=left, **{**truth, **extra}), plan)
+        assert act is None and why.startswith(CORRECTIONS[name].split("{")[0]), (name, why)
+        assert not _secret_checks(why), (name, why, _secret_checks(why))
+    # the route refusal under other ground truth (another room, no goal room told, another place): the same words
+    a = get_llm_agent("tandem")
+    other = a._check(TandemMemory(), _decision(room=KITCHEN, odometry=[-2.0, 0.5]), _plan("ask", question_type=3))[1]
+    assert other == CORRECTIONS["route"] == a._check(TandemMemory(room_claim="the office"), _decision(**truth),
+                                                     _plan("ask", question_type=3))[1]
+    # the checks catch what the old refusal said
+    assert _secret_checks("when the goal room is known but you are not in it; none applies here")
 
 
 def test_anti_oscillation():
@@ -169,6 +271,7 @@ def test_spatial_memory_merges_belief_updates_unless_ablated():
     m2 = TandemMemory()
     b._merge(m2, d, _plan())
     assert m2.current_room == "unknown" and "Spatial Memory" not in b.state_text(m2, d)
+    assert m.room_claim == m2.room_claim == "hall"  # the controller reads where the agent thinks it is either way
     c = get_llm_agent("mapgpt")
     m3 = TandemMemory()
     c._merge(m3, d, _plan())
@@ -201,8 +304,8 @@ SCRIPT = {1: _plan("ask", question_type=1), 2: _plan("ask", question_type=1),
           3: _plan("move", direction="left", subgoal="the open doorway"),
           4: _plan("move", direction="front-right", subgoal="the corner by the window"), 5: _plan("stop"), 6: _plan("stop")}
 """Planner replies per turn: T1; T1 again (refused by safeguard 1, corrected to T2); two moves; a stop without
-evidence (turned into a confirmation); a stop."""
-CELLS = {"the open doorway": (1, 1), "the corner by the window": (8, 8)}
+evidence (turned into a confirmation); a stop right after the "no" (corrected, then a move)."""
+CELLS = {"the open doorway": (1, 1), "the corner by the window": (8, 8), "the middle of the room": (4, 2)}
 """The Grounder's cells, by subgoal (grid corners)."""
 
 
@@ -214,6 +317,8 @@ def _script_policy(req: dict) -> str:
     turn = int(re.search(r"Turn (\d+) of", text).group(1))
     if "already in the Fact Base" in text:  # the correction after the repeated Type-1 question
         return json.dumps(_plan("ask", question_type=2))
+    if CORRECTIONS["stop_after_no"] in text:  # the correction after a stop right after a "no"
+        return json.dumps(_plan("move", direction="front", subgoal="the open doorway"))
     return json.dumps(SCRIPT[turn])
 
 
@@ -234,12 +339,13 @@ def test_each_decision_path_end_to_end(episodes, tmp_path):
     # the Planner's question texts reach the transcript; the stop turned into a confirmation has none
     assert [c["question"] for c in calls if c["action"] and c["action"][0] == ASK] == ["?", "?", ""]
     assert all("question" not in c for c in calls if c["action"] and c["action"][0] != ASK)
-    assert res.accounting["invalid_replies"].tolist() == [1]  # the repeated Type-1 question
+    assert acts[5][2][:2] == [MOVE, 0]  # the stop right after the "no", corrected into a move
+    assert res.accounting["invalid_replies"].tolist() == [2]  # the repeated Type-1 question, that stop
     roles = [c["role"] for c in calls]
-    assert roles.count("grounder") == 2 and bodies == res.accounting["requests"].sum()
+    assert roles.count("grounder") == 3 and bodies == res.accounting["requests"].sum()
     # the Grounder saw one image (the selected view) and the subgoal; the Planner the panel
     g = [c for c in calls if c["role"] == "grounder"]
-    assert [len(c["images"]) for c in g] == [1, 1]
+    assert [len(c["images"]) for c in g] == [1, 1, 1]
     assert "the open doorway" in g[0]["prompt"] and "the corner by the window" in g[1]["prompt"]
     p = [c for c in calls if c["role"] == "planner"]
     assert all(len(c["images"]) == 1 for c in p)
@@ -250,6 +356,49 @@ def test_each_decision_path_end_to_end(episodes, tmp_path):
     # Grounder images were saved beside the panels
     saved = sorted(x.name for x in (tmp_path / "images" / "tandem").rglob("*.jpg"))
     assert any("grounder_2" in n for n in saved) and any("panel" in n for n in saved)
+
+
+SCHEDULE_SCRIPT = {1: _plan("move", direction="front", subgoal="the open doorway"),
+                   3: _plan("move", direction="front-right", subgoal="the corner by the window"),
+                   4: _plan("move", direction="left", subgoal="the open doorway"), 6: _plan("stop"), 7: _plan("stop"),
+                   8: _plan("stop")}
+"""Planner replies per turn of a Planner that never asks: moves, then stops (turns 2 and 5 belong to the schedule)."""
+
+
+def _schedule_policy(req: dict) -> str:
+    text = _texts(req)
+    if req["response_format"]["json_schema"]["name"] == "grounder_cell":
+        col, row = CELLS[re.search(r"Navigation instruction: (.*)", text).group(1).strip()]
+        return json.dumps({"col": col, "row": row, "rationale": "scripted"})
+    if CORRECTIONS["stop_after_no"] in text:  # a move that gets somewhere on this episode
+        return json.dumps(_plan("move", direction="right", subgoal="the middle of the room"))
+    return json.dumps(SCHEDULE_SCRIPT[int(re.search(r"Turn (\d+) of", text).group(1))])
+
+
+@render_ok
+def test_early_questions_and_every_unconfirmed_stop_end_to_end(episodes):
+    """Against the scripted server, a Planner that never asks and keeps stopping: the controller asks Type 2 at
+    the second decision and Type 1 at the fifth (the early-question schedule), turns each stop without
+    confirmation into a Type-4 question (twice: every time, not only before the first), and corrects the stop
+    that comes right after a "no" with no move since; the correction carries no secret."""
+    with ScriptedServer(policy=_schedule_policy) as srv:
+        res = run_llm_agent(episodes.subset([0]), get_llm_agent("tandem"), _llm(srv), sim=T.SimConfig(max_steps=8),
+                            views=VIEWS, batch=1)
+    calls = res.transcripts
+    acts = {c["step"]: c["action"] for c in calls if c["action"] is not None}
+    assert [(c["step"], c["action"]) for c in calls if c["role"] == "controller"] == [(1, [ASK, 0, 4, 1, 2]),
+                                                                                     (4, [ASK, 0, 4, 1, 1])]
+    planner_steps = {c["step"] for c in calls if c["role"] == "planner"}
+    assert planner_steps == {0, 2, 3, 5, 6, 7}  # the schedule's questions need no model call
+    assert acts[5] == [ASK, 0, 4, 1, 4] and acts[7] == [ASK, 0, 4, 1, 4]  # each unconfirmed stop confirmed
+    assert acts[6][:4] == [MOVE, 6, 4, 2]  # the stop right after the "no": corrected, then a move (to the right)
+    step6 = [c for c in calls if c["step"] == 6 and c["role"] == "planner"][0]
+    assert [r["error"] for r in step6["retries"]] == [CORRECTIONS["stop_after_no"]]
+    assert res.outcomes.n_questions[0].tolist() == [1, 1, 0, 2] and res.accounting["invalid_replies"].tolist() == [1]
+    # the "no" was heard, and both facts reached the Planner's Fact Base after the schedule asked them
+    assert "last confirmation: No" in step6["prompt"] and "appearance:" in step6["prompt"]
+    assert "location:" in [c for c in calls if c["step"] == 2 and c["role"] == "planner"][0]["prompt"]
+    assert not [e for c in calls for r in c["retries"] for e in [r["error"]] if _secret_checks(e)]
 
 
 @render_ok
@@ -285,6 +434,8 @@ def test_baselines_send_what_they_should(episodes, name):
         assert (res.outcomes.n_questions[:, :2] == 1).all()  # the description, given at reset and charged
     views = {"tandem-4v": 4, "tandem-12v": 12}.get(name, 8)
     assert f"{views} camera views" in system or f"your {views} directions" in system
+    if name != "navgpt":  # each view's own width: 90 degrees for 4 and 8 views, 30 for the 12 narrow ones
+        assert f"each {30 if views == 12 else 90} degrees wide" in system
 
 
 # ---------------------------------------------------------------------------
