@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from ignjax.cache.clock import in_phase
 from ignjax.agents import Agent, get_agent
 from ignjax.episodes.dataset import BenchmarkScenes, EpisodeSet
-from ignjax.sim.rollout import episode_keys, pad_batch, rollout
+from ignjax.sim.rollout import compile_ahead, episode_keys, pad_batch, rollout, rollout_call
 from ignjax.sim.env import check_specs
 from ignjax.sim.world import FINE, World
 from ignjax.errors import ConfigError
@@ -194,6 +194,16 @@ def bucket_worlds(bs: BenchmarkScenes, plans: dict, todo: dict, config: SimConfi
         del es, world
 
 
+def batch_program(es: EpisodeSet, world: World, agent, params, batch: int, seed: int, chunk: int,
+                  parts: int | None = None, sweep: bool = False) -> tuple:
+    """The rollout program (:func:`ignjax.sim.rollout.rollout_call`) of chunk ``chunk`` of ``es`` cut in batches
+    of ``batch`` (:func:`episode_batches`; every chunk of a run is the same program), for
+    :func:`ignjax.sim.rollout.compile_ahead`. ``sweep``: ``params`` carry a leading axis of settings."""
+    agent = get_agent(agent) if isinstance(agent, str) else agent
+    _, specs, keys = next(episode_batches(es, batch, seed, select=[chunk]))
+    return rollout_call(world, specs, agent, params, keys, parts=parts, sweep=sweep)
+
+
 def bucket_batches(bs: BenchmarkScenes, plan: BucketPlan, jobs: dict, *, seed: int = 0,
                    config: SimConfig = SimConfig(), parts: int | None = None):
     """Roll out the batches ``jobs`` name, a bucket at a time (:func:`bucket_worlds`).
@@ -208,6 +218,9 @@ def bucket_batches(bs: BenchmarkScenes, plan: BucketPlan, jobs: dict, *, seed: i
     """
     todo = {name: idx for name, (_, _, idx) in jobs.items()}
     for es, world, work in bucket_worlds(bs, dict.fromkeys(jobs, plan), todo, config):
+        busy = [(agent, params, work[name][0][1]) for name, (agent, params, _) in jobs.items() if work[name]]
+        if len(busy) > 1:  # several agents' programs compile side by side
+            compile_ahead([batch_program(es, world, agent, params, plan.batch, seed, c, parts) for agent, params, c in busy])
         for name, (agent, params, _) in jobs.items():
             if not work[name]:
                 continue
@@ -217,5 +230,5 @@ def bucket_batches(bs: BenchmarkScenes, plan: BucketPlan, jobs: dict, *, seed: i
                 yield name, index[c], out, traj
 
 
-__all__ = ["BANK_MB", "BucketPlan", "WORLD_BYTES_PER_CELL", "agent_batches", "batch_count", "bucket_batches",
+__all__ = ["BANK_MB", "BucketPlan", "WORLD_BYTES_PER_CELL", "agent_batches", "batch_count", "batch_program", "bucket_batches",
            "bucket_worlds", "episode_batches", "make_world", "plan_run", "run_agent"]

@@ -39,9 +39,9 @@ from ignjax.episodes.construct import BuildConfig, build_benchmark
 from ignjax.episodes.dataset import BenchmarkScenes, open_benchmark
 from ignjax.episodes.schema import construction_path, read_episodes, write_records
 from ignjax.errors import ConfigError, InputError
-from ignjax.evaluate.runner import BucketPlan, agent_batches, bucket_worlds, episode_batches, plan_run
+from ignjax.evaluate.runner import BucketPlan, agent_batches, batch_program, bucket_worlds, episode_batches, plan_run
 from ignjax.scenes.io.sources import scene_sources
-from ignjax.sim.rollout import batch_parts, compile_ahead, rollout_call, rollout_sweep
+from ignjax.sim.rollout import batch_parts, compile_ahead, rollout_sweep
 from ignjax.sweep.checkpoints import Checkpoints, prepare_folder
 from ignjax.sweep.report import in_loop_costs, write_outputs
 
@@ -158,19 +158,19 @@ def _costs_params(cfg: SweepConfig, agent, costs):
 
 
 def _stage_programs(es, world, work: dict, plans: dict, cfg: SweepConfig, c_agent, c_params) -> list:
-    """The rollout program of each stage with work in this bucket (:func:`ignjax.sim.rollout.rollout_call`, for
-    its first batch: every batch of a stage is the same program), so they compile side by side."""
-    calls = []
+    """The rollout program of each stage with work in this bucket (for its first batch: every batch of a stage is
+    the same program), so they compile side by side (:func:`ignjax.sim.rollout.compile_ahead`)."""
+    calls, parts, seed = [], cfg.eval.parts or None, cfg.run.seed
     for stage, batches in work.items():
         if not batches:
             continue
-        _, specs, keys = next(episode_batches(es, plans[stage].batch, cfg.run.seed, select=[batches[0][1]]))
+        chunk, batch = batches[0][1], plans[stage].batch
         if stage == "costs/in_loop":
-            calls.append(rollout_call(world, specs, c_agent, c_params, keys, parts=cfg.eval.parts or None, sweep=True))
+            calls.append(batch_program(es, world, c_agent, c_params, batch, seed, chunk, parts, sweep=True))
         else:
             agent = stage.split("/", 1)[1]
-            calls.append(rollout_call(world, specs, get_agent(agent), cfg.agents.make(agent, costs=cfg.eval.costs),
-                                      keys, parts=cfg.eval.parts or None))
+            calls.append(batch_program(es, world, agent, cfg.agents.make(agent, costs=cfg.eval.costs), batch, seed,
+                                       chunk, parts))
     return calls
 
 
