@@ -69,7 +69,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from ignjax.agents.llm.agent import ASK, MOVE, MOVED_M, QUESTION_HELP, QUESTION_NAMES, STOP, Decision, LLMAgent
+from ignjax.agents.llm.agent import (ASK, MOVE, MOVED_M, NO_QUESTIONS_LEFT, QUESTION_HELP, QUESTION_NAMES, STOP,
+                                     Decision, LLMAgent)
 from ignjax.agents.llm.client import ChatRequest
 from ignjax.sim import types as T
 from ignjax.sim.views.compose import view_names
@@ -257,15 +258,22 @@ class Tandem(LLMAgent):
 
     def _controller(self, m: TandemMemory, d: Decision):
         """An action the controller takes without asking the model, or None."""
+        ruled = self._controller_rule(m, d)
+        return None if ruled is None else ruled[0]
+
+    def _controller_rule(self, m: TandemMemory, d: Decision):
+        """``(action, rule, what it did in words)`` when the controller decides without asking the model, or None."""
         p = d.percept
         if not self.safeguards:
             return None
         if p.get("follow_up") == T.FOLLOW_STOP_NOW and p.get("confirm") == 1:
-            return (STOP, 0, 4, 1, 1)
+            return (STOP, 0, 4, 1, 1), "stop after confirmation", ("the helper confirmed the target and said to stop "
+                                                                   "now: stop")
         if (self.qa and self.route_questions and d.questions_left > 0 and m.moves_since_hint >= RECOVERY_MOVES
                 and not p.get("hint_active") and p.get("confirm") != 1):
-            m.moves_since_hint = 0
-            return (ASK, 0, 4, 1, 3)
+            moves, m.moves_since_hint = m.moves_since_hint, 0
+            return (ASK, 0, 4, 1, 3), "recovery", (f"{moves} moves without a route hint or a confirmed candidate: "
+                                                   f"ask a route question (type 3, {QUESTION_HELP[3]})")
         return None
 
     def _check(self, m: TandemMemory, d: Decision, parsed: dict):
@@ -284,7 +292,7 @@ class Tandem(LLMAgent):
             if t == 3 and not self.route_questions:
                 return None, "route questions (type 3) are not available to you; ask another type or move"
             if d.questions_left <= 0:
-                return None, "no questions are left; choose move or stop"
+                return None, NO_QUESTIONS_LEFT
             if self.safeguards:
                 if follow:
                     return None, "the target is confirmed; make one closer move toward it, then stop"
@@ -490,8 +498,11 @@ class Tandem(LLMAgent):
     async def decide(self, ctx, m: TandemMemory, d: Decision):
         self._observe_outcome(m, d)
         question = ""  # the Planner's question text; none when the controller asks (recovery, confirm before stop)
-        act = self._controller(m, d)
-        if act is None:
+        ruled = self._controller_rule(m, d)
+        if ruled is not None:
+            act = ruled[0]
+            ctx.note_rule(*ruled[1:])
+        else:
             plan = await ctx.query(self.planner_request(m, d), lambda parsed, err: self._parse_plan(m, d, parsed, err))
             if plan is None:
                 act = ctx.default(self.default_action(m, d))
@@ -503,6 +514,9 @@ class Tandem(LLMAgent):
                     act = await self._ground(ctx, m, d, act, parsed)
                 elif act[0] == ASK and parsed.get("action") == "ask":  # not a stop turned into a confirmation
                     question = _clip(parsed.get("question"))
+                elif act[0] == ASK:
+                    ctx.note_rule("confirm before stop", "the Planner chose stop without evidence (no confirmed "
+                                  "target, no hint that it is near): ask a confirmation question (type 4) instead")
         self._record(m, d, act, question)
         if act[0] == ASK and question:
             ctx.note_question(question)
