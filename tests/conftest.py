@@ -153,7 +153,8 @@ def work_unit(nodeid: str) -> str:
 HEAVY_UNITS = (
     "tests/agents/test_agents.py", "tests/sweep/test_sweep.py", "tests/agents/llm/test_tandem.py", VLLM_TESTS,
     "tests/sim/test_sim.py", "tests/evaluate/test_buckets.py", "tests/devices/test_processes.py",
-    "tests/sweep/test_sweep_llm.py", "tests/evaluate/test_hostloop.py", "tests/sim/test_sharding.py",
+    "tests/sweep/test_sweep_llm.py", "tests/evaluate/test_hostloop.py", "tests/evaluate/test_recovery.py",
+    "tests/sim/test_sharding.py",
     "tests/test_notebooks.py", "tests/build/test_build_workers.py",
 )
 """The units of work that take longest on the 2-core CI machine, longest

@@ -22,6 +22,16 @@ an endpoint that does not answer within ``llm.timeout_s``, or a
 endpoint, or the model and the ones served. ``--llm-replay`` and
 ``--dry-run`` ask nothing.
 
+Exit status: 0; 2 on an error (settings, input files, the model server's
+check), with nothing written; 3
+(:data:`ignjax.evaluate.recovery.MODEL_FAILURE_EXIT`) when an MLLM agent's
+episode ended by a model failure (its requests kept failing): every output
+is written, and a line on stderr says how many episodes of which agent
+ended so. Running the same command again runs those episodes again, the
+replies they got coming from the reply cache; the episodes that ended
+normally are kept (``OUT/llm/<agent>.progress.jsonl``,
+:mod:`ignjax.evaluate.recovery`).
+
 ``--set sim.<key>=<value>`` sets any :class:`~ignjax.sim.types.SimConfig`
 field and ``--set agents.<name>.<key>=<value>`` any agent parameter (the keys
 of the sweep's ``[sim]`` and ``[agents.<name>]`` tables). A cost-aware agent
@@ -128,7 +138,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="print what the MLLM agents would send (requests, images, estimated tokens and cost) and exit "
                         "without sending anything or loading scenes")
     g.add_argument("--save-images", type=int, default=0, metavar="N",
-                   help="write the panels of the first N episodes to OUT/images (for python -m ignjax.view)")
+                   help="write the images of the first N episodes (Planner panels, Grounder views) to OUT/images "
+                        "(for python -m ignjax.view)")
     return p
 
 
@@ -205,10 +216,10 @@ def llm_settings(args, sections: dict, out_dir: Path):
 
 
 def _dry_run(args, agents, llm_agents, sim, llm, views, costs) -> int:
-    """``--dry-run``: the upper bounds of :func:`ignjax.evaluate.hostloop.dry_run` per MLLM agent, as JSON lines."""
+    """``--dry-run``: the upper bounds of :func:`ignjax.evaluate.dryrun.dry_run` per MLLM agent, as JSON lines."""
     from ignjax.agents.llm.client import price
     from ignjax.episodes.schema import read_episodes
-    from ignjax.evaluate.hostloop import dry_run
+    from ignjax.evaluate.dryrun import dry_run
 
     n = len(read_episodes(args.episodes))
     n = min(n, args.limit) if args.limit else n
@@ -373,11 +384,15 @@ def run(args, settings: dict | None = None, popts: PR.ProcessOptions = PR.Proces
                   + (f" ({reused[name]} from an earlier run)" if reused[name] else "")
                   + (f" (process 0 of {group.count})" if group.count > 1 else ""), file=sys.stderr)
     group.barrier("parts")
+    status = 0
     if group.main:
-        _write_outputs(args, st, bs, plan, store, used, llm_names)
+        from ignjax.evaluate.recovery import report_model_failures
+
+        failures = _write_outputs(args, st, bs, plan, store, used, llm_names)
         store.remove()
+        status = report_model_failures(failures, "run the same command again")
     group.barrier("written")
-    return 0
+    return status
 
 
 def _image_size(st: dict) -> int | None:
@@ -390,12 +405,14 @@ def _fields(obj) -> dict:
     return {f.name: np.asarray(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
 
 
-def _write_outputs(args, st: dict, bs, plan, store, used: dict, llm_names: set) -> None:
-    """Process 0: the JAX-native agents' outcomes from the parts, the MLLM agents' from the host loop, every file."""
+def _write_outputs(args, st: dict, bs, plan, store, used: dict, llm_names: set) -> dict[str, list[str]]:
+    """Process 0: the JAX-native agents' outcomes from the parts, the MLLM agents' from the host loop, every file.
+    Returns each MLLM agent's ``failure`` texts, one per episode ("" where it did not end by a model failure)."""
     from types import SimpleNamespace
 
     from ignjax.evaluate import metrics as M
-    from ignjax.evaluate.hostloop import run_llm_agent, write_transcripts
+    from ignjax.evaluate.accounting import run_line, write_transcripts
+    from ignjax.evaluate.hostloop import run_llm_agent
     from ignjax.evaluate.outcomes import (TRAJECTORY_FILE, metric_rows, model_totals, outcome_rows, per_episode_text,
                                           write_metric_table, write_outcomes, write_trajectories)
 
@@ -403,6 +420,7 @@ def _write_outputs(args, st: dict, bs, plan, store, used: dict, llm_names: set) 
     thresholds, costs = st["thresholds"], st["costs"]
     rows = []
     trajectories = {}
+    failures: dict[str, list[str]] = {}
     records = bs.records
     es = bs.episode_set(plan.buckets[0]) if llm_names else None  # one bucket: checked before the run
     for agent in agents:
@@ -415,9 +433,8 @@ def _write_outputs(args, st: dict, bs, plan, store, used: dict, llm_names: set) 
             write_transcripts(out_dir, agent.name, res.transcripts)
             used[agent.name] = {"options": {k: v for k, v in vars(agent).items()}, "llm": llm.public_dict(),
                                 "views": dataclasses.asdict(views)}
-            print(f"{agent.name}: {len(es)} episodes in {time.perf_counter() - t1:.1f} s, "
-                  f"{res.stats['requests']} requests sent ({res.stats['resumed']} episodes from an earlier run)",
-                  file=sys.stderr)
+            failures[agent.name] = list(res.accounting["failure"])
+            print(run_line(agent.name, len(es), time.perf_counter() - t1, res.stats), file=sys.stderr)
             continue
         tree = plan.to_run_order(store.gather(f"eval/{agent.name}", len(plan.chunks)))
         rows += outcome_rows(agent.name, records, SimpleNamespace(**tree["out"]))
@@ -442,13 +459,15 @@ def _write_outputs(args, st: dict, bs, plan, store, used: dict, llm_names: set) 
         cost = f", estimated cost {totals['cost_usd']:.4f} USD" if totals["cost_usd"] is not None else ""
         rejected = (f", {totals['paraphrase_rejected']} paraphrases refused (template used)"
                     if llm is not None and llm.paraphrase else "")
-        print(f"{name}: {totals['requests']} requests, {totals['cache_hits']} cache hits, "
+        print(f"{name}: in the outcomes (this run and the episodes kept from earlier ones): "
+              f"{totals['requests']} requests, {totals['cache_hits']} cache hits, "
               f"{totals['prompt_tokens']} + {totals['completion_tokens']} tokens, {totals['retries']} retries, "
-              f"{totals['invalid_replies']} invalid replies, {totals['failures']} episodes ended by model failure"
-              f"{rejected}{cost}")
+              f"{totals['invalid_replies']} invalid replies ({totals['refused_asks']} asks with no question left), "
+              f"{totals['failures']} episodes ended by model failure{rejected}{cost}")
         print(f"{name}: {per_episode_text(totals)}")
     print(f"wrote {p_parquet}, {p_csv}, {out_dir / 'metrics.csv'}, {out_dir / TRAJECTORY_FILE} and "
           f"{out_dir / 'run.json'} (view the episodes: python -m ignjax.view {out_dir})")
+    return failures
 
 
 if __name__ == "__main__":

@@ -37,7 +37,7 @@ Question texts: an agent that writes its questions
 (:attr:`~ignjax.agents.llm.agent.LLMAgent.writes_questions`) hands the text
 of an ASK to ``ctx.note_question``; the decision's transcript record carries
 it as ``question`` ("" when the agent's controller asked without one), and
-:func:`question_texts` collects them (the Type-3 content analysis reads
+:func:`ignjax.evaluate.accounting.question_texts` collects them (the Type-3 content analysis reads
 them). The oracle answers by type either way.
 
 Paraphrase (``llm.paraphrase``): before a decision, each oracle answer the
@@ -50,12 +50,18 @@ otherwise (or when the reply is unusable) the template stays and the
 episode's ``paraphrase_rejected`` counts it. An answer the agent never reads
 (asked at the episode's last step) is not paraphrased.
 
-Resume: every finished episode is appended to ``<out>/llm/<agent>.progress.jsonl``
-(flushed and synced). A run started again with the same settings skips the
-episodes found there and re-runs the others from their start; their earlier
-requests come from the response cache (no request sent twice, no question
-charged twice: the simulator replays the same decisions), so the outcomes
-equal an uninterrupted run. A file written with other settings is refused.
+Resume and recovery (:mod:`ignjax.evaluate.recovery`): every episode that
+ends is appended to ``<out>/llm/<agent>.progress.jsonl`` (flushed and synced).
+A run started again with the same settings keeps the episodes that ended
+normally there and runs the others from their start, those that ended by a
+model failure included; their earlier requests come from the response cache
+(no request sent twice, no question charged twice: the simulator replays the
+same decisions), so the outcomes equal an uninterrupted run. A file written
+with other settings is refused.
+
+Accounting and transcripts (:mod:`ignjax.evaluate.accounting`): every HTTP
+attempt counts as a request, answered or not; the controller's own decisions
+are transcript records of role ``controller`` naming the rule that fired.
 
 Determinism: an episode's course depends on its episode, its key (seed and
 index in the file), the simulator and the replies; not on its slot, the
@@ -83,8 +89,10 @@ from ignjax.agents.llm.cache import ResponseCache
 from ignjax.agents.llm.client import ChatClient, ChatRequest, ImagePart, LLMRequestError
 from ignjax.agents.llm.config import LLMConfig
 from ignjax.episodes.dataset import EpisodeSet
-from ignjax.errors import ConfigError, InputError
-from ignjax.evaluate.outcomes import ACCOUNTING_COLUMNS
+from ignjax.errors import ConfigError
+from ignjax.evaluate import accounting as A
+from ignjax.evaluate.accounting import ACCOUNTING
+from ignjax.evaluate.recovery import ProgressLog
 from ignjax.fileio import atomic_write
 from ignjax.protocol import LOCKED_COSTS
 from ignjax.scenes import vocab
@@ -94,18 +102,13 @@ from ignjax.sim import types as T
 from ignjax.sim.rollout import episode_keys, step_record
 from ignjax.sim.views import ViewConfig
 
-ACCOUNTING = tuple(c for c in ACCOUNTING_COLUMNS if c != "failure")
-"""Per-episode counters of an MLLM agent (:data:`ignjax.evaluate.outcomes.ACCOUNTING_COLUMNS`;
-``failure`` is kept beside them as text)."""
-
-
 @dataclass
 class _Episode:
     index: int
     memory: object
     answers: list = field(default_factory=list)
     calls: list = field(default_factory=list)
-    acc: dict = field(default_factory=lambda: {k: 0 for k in ACCOUNTING})
+    acc: dict = field(default_factory=A.new_accounting)
     failure: str = ""
     progress: str = ""
     images: list = field(default_factory=list)
@@ -120,7 +123,9 @@ class LoopResult:
         outcomes: :class:`~ignjax.sim.types.OutcomeRow` of numpy arrays (E,).
         trajectories: :class:`~ignjax.sim.types.Trajectory` of numpy arrays (E, ...).
         accounting: column name -> (E,) array (:data:`ACCOUNTING`), plus ``failure`` (list of str).
-        stats: run totals: wall time, decisions, utilisation, requests in flight,
+        stats: this run's totals: wall time, decisions, utilisation, ``requests`` (HTTP attempts sent in this
+            run) and ``retries``, requests in flight, ``resumed`` (episodes kept from an earlier run), ``rerun``
+            (episodes that had ended by a model failure, run again), ``failures`` (episodes that ended by one now),
             ``paraphrased`` (paraphrase calls) and ``paraphrase_rejected``.
         transcripts: the transcript records (viewer schema plus request hash,
             image hashes, tokens, latency, cache hit), sorted by episode and step.
@@ -224,12 +229,18 @@ class _Context:
         self._loop, self._client, self._ep, self._d = loop, client, ep, d
         self.defaulted = False
         self.question = ""
+        self.rule: tuple[str, str] | None = None
 
     def note_question(self, text: str) -> None:
         """Record the text of the question this decision asks (agents that
         write their questions): the decision's transcript record carries it
         as ``question``. The oracle answers by type; the text is a record."""
         self.question = str(text)
+
+    def note_rule(self, rule: str, text: str) -> None:
+        """Record that the agent's controller decided (or changed) this decision by ``rule``, and what it did in
+        words (``text``): the decision's transcript record carries both."""
+        self.rule = (str(rule), str(text))
 
     async def query(self, request, parse, role: str = "planner", reasks: int | None = None):
         """Send ``request``; ``parse(parsed, parse_error) -> (value, error)``
@@ -258,7 +269,7 @@ class _Context:
         data = encode_images(grounder_images(rgb[int(k)][None]), fmt, self._loop.views.quality)[0]
         img = ImagePart(data, "image/jpeg" if fmt == "jpeg" else "image/png")
         if self._ep.index < self._loop.save_images:
-            self._ep.images.append((self._d.step, img, f"grounder_{int(k)}"))
+            self._ep.images.append((self._d.step, img, "grounder"))
         return img
 
     def default(self, action):
@@ -309,32 +320,6 @@ class HostLoop:
         from ignjax.sim.views.compose import view_names
 
         return view_names(self.sim.n_views)
-
-    # -- checkpoint -----------------------------------------------------------
-    def _progress_path(self) -> Path | None:
-        return None if self.out is None else self.out / "llm" / f"{self.agent.name}.progress.jsonl"
-
-    def _load_progress(self, key: str) -> dict[int, dict]:
-        path = self._progress_path()
-        if path is None or not path.exists():
-            return {}
-        done = {}
-        with open(path, encoding="utf-8") as fh:
-            lines = fh.read().split("\n")
-        try:
-            head = json.loads(lines[0])
-        except (json.JSONDecodeError, IndexError):
-            raise InputError(path, "line 1", "not a progress header; delete the file to start over") from None
-        if head.get("settings") != key:
-            raise InputError(path, "settings", "the run there was made with other settings (episodes, agent, model, "
-                                               "simulator, views, seed or costs); use another --out or delete it")
-        for line in lines[1:]:
-            try:
-                rec = json.loads(line)
-            except json.JSONDecodeError:
-                continue  # the last line of a killed run may be cut
-            done[int(rec["index"])] = rec
-        return done
 
     # -- per-row host work ----------------------------------------------------
     def _prepare(self, rows, slots, states, obs) -> list[dict]:
@@ -401,7 +386,10 @@ class HostLoop:
         except LLMRequestError as e:
             return "fail", str(e)
         if len(ep.calls) == first:  # decided by the agent's controller alone: no model call
-            ep.calls.append(self._call(d, None, None, act, [], None, role="controller"))
+            rule, text = ctx.rule or ("controller", "")
+            ep.calls.append(A.controller_record(self.agent.name, d, act, rule, text))
+        elif ctx.rule:
+            ep.calls[-1]["rule"], ep.calls[-1]["text"] = ctx.rule
         ep.calls[-1]["action"] = list(act)
         if act[0] == ASK and self.agent.writes_questions:
             ep.calls[-1]["question"] = ctx.question
@@ -437,51 +425,29 @@ class HostLoop:
             try:
                 res = await client.complete(req)
             except LLMRequestError as e:
-                ep.calls.append(self._call(d, req, None, None, earlier, str(e), role=role))
+                A.count_failed_call(ep.acc, e)
+                ep.calls.append(A.call_record(self.agent.name, d, req, None, None, earlier, str(e), role=role))
                 raise
-            ep.acc["requests"] += 0 if res.cache_hit else 1
-            ep.acc["cache_hits"] += int(res.cache_hit)
-            ep.acc["prompt_tokens"] += res.prompt_tokens
-            ep.acc["completion_tokens"] += res.completion_tokens
-            ep.acc["retries"] += res.retries
-            ep.acc["model_latency_s"] += 0.0 if res.cache_hit else res.latency_s
+            A.count_reply(ep.acc, res)
             value, err = parse(res.parsed, res.parse_error)
             if value is not None:
-                ep.calls.append(self._call(d, req, res, None, earlier, None, role=role))
+                ep.calls.append(A.call_record(self.agent.name, d, req, res, None, earlier, None, role=role))
                 return value
-            ep.acc["invalid_replies"] += 1
+            A.count_unusable(ep.acc, err)
             earlier.append({"reply": res.text, "error": err, "request_hash": res.request_hash})
             if attempt < reasks:
                 req = self.agent.correction(ep.memory, d, req, res.text, err)
-        ep.calls.append(self._call(d, req, res, None, earlier[:-1], f"invalid replies: {earlier[-1]['error']}",
-                                   role=role))
+        ep.calls.append(A.call_record(self.agent.name, d, req, res, None, earlier[:-1],
+                                      f"invalid replies: {earlier[-1]['error']}", role=role))
         return None
-
-    def _call(self, d: Decision, req, res, act, earlier, error, role: str = "planner") -> dict:
-        msgs = req.messages if req is not None else []
-        text = "\n\n".join(p if isinstance(p, str) else p.get("text", "") if isinstance(p, dict) else f"[image {p.sha256[:12]}]"
-                           for m in msgs for p in ([m["content"]] if isinstance(m["content"], str) else m["content"]))
-        images = [p.sha256 for m in msgs if not isinstance(m["content"], str) for p in m["content"]
-                  if isinstance(p, ImagePart)]
-        return {"agent": self.agent.name, "episode": d.episode, "step": d.step, "role": role, "prompt": text,
-                "reply": res.text if res else "", "parsed": res.parsed if res else None, "retries": earlier,
-                "error": error, "action": list(act) if act else None,
-                "request_hash": res.request_hash if res else None, "images": images,
-                "prompt_tokens": res.prompt_tokens if res else 0, "completion_tokens": res.completion_tokens if res else 0,
-                "latency_s": round(res.latency_s, 4) if res else 0.0, "cache_hit": bool(res.cache_hit) if res else False,
-                "http_retries": res.retries if res else 0}
 
     # -- the loop -------------------------------------------------------------
     async def run(self) -> LoopResult:
         key = _settings_hash(self.es, self.agent, self.llm, self.sim, self.views, self.seed, self.costs)
-        finished = self._load_progress(key)
-        path = self._progress_path()
-        log = None
-        if path is not None:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            if not path.exists():
-                atomic_write(path, json.dumps({"settings": key, "agent": self.agent.name, "episodes": self.n}) + "\n")
-            log = open(path, "a", encoding="utf-8")
+        log = ProgressLog(None if self.out is None else self.out / "llm" / f"{self.agent.name}.progress.jsonl", key,
+                          self.agent.name, self.n)
+        finished, failed_before = log.load()
+        log.open()
         queue = [i for i in range(self.n) if i not in finished]
         queue.reverse()
         B, specs_all = self.B, self.es.specs
@@ -606,10 +572,7 @@ class HostLoop:
                             ep = slots[r]
                             entry = self._entry(ep, outs, r, traj_rows.pop(ep.index), pose[r])
                             records[ep.index] = entry
-                            if log:
-                                log.write(json.dumps(entry) + "\n")
-                                log.flush()
-                                os.fsync(log.fileno())
+                            log.append(entry)
                             self._write_images(ep)
                             slots[r] = None
                             if bar:
@@ -625,8 +588,7 @@ class HostLoop:
                 util = client.utilisation(t_stats0)
                 wall = time.perf_counter() - t_start
         finally:
-            if log:
-                log.close()
+            log.close()
             if bar:
                 bar.close()
             if cache is not None:
@@ -636,7 +598,9 @@ class HostLoop:
         records.update(finished)
         return self._result(records, {"wall_s": wall, "decisions": decisions,
                                       "utilisation": util, "requests": stats.requests_sent,
-                                      "max_in_flight": stats.max_in_flight, "resumed": len(finished),
+                                      "retries": stats.retries, "max_in_flight": stats.max_in_flight,
+                                      "resumed": len(finished), "rerun": len(failed_before),
+                                      "failures": sum(bool(r["failure"]) for r in records.values()),
                                       "paraphrased": sum(c["role"] == "paraphrase" for r in records.values()
                                                          for c in r["calls"]),
                                       "paraphrase_rejected": sum(r["accounting"]["paraphrase_rejected"]
@@ -704,70 +668,6 @@ class HostLoop:
         return LoopResult(outcomes=outcomes, trajectories=traj, accounting=acc, stats=stats, transcripts=calls)
 
 
-IMAGE_TOKEN_PX = 28
-"""Side of the image patch one vision token covers in the dry-run estimate (Qwen2-VL-style models: 14 px patches
-merged 2x2); other models count differently, so the figure is an estimate."""
-
-
-def dry_run(agent: LLMAgent, n_episodes: int, *, sim: T.SimConfig = T.SimConfig(), views: ViewConfig = ViewConfig(),
-            llm: LLMConfig | None = None, costs=LOCKED_COSTS) -> dict:
-    """What running ``agent`` on ``n_episodes`` episodes would send at most,
-    before sending anything: requests (every decision a Planner call, every
-    decision a move for two-stage agents; with ``llm.paraphrase`` one
-    paraphrase per question, as many questions as the budget allows; re-asks
-    not counted), images, and
-    an estimate of prompt tokens (text at 4 characters a token, images at one
-    token per :data:`IMAGE_TOKEN_PX` square) and of completion tokens
-    (``llm.max_tokens`` per request, the cap). The prompts are built from a
-    first decision of an episode with no answers yet."""
-    from ignjax.sim.views.compose import panel_layout
-
-    sim = dataclasses.replace(sim, **dict(getattr(agent, "sim_overrides", {}) or {}))
-    two_stage = bool(getattr(agent, "two_stage", False)) and agent.observation == "panel"
-    img = ImagePart(b"\xff\xd8\xff\xd9") if agent.observation == "panel" else None
-    d = Decision(episode="dry-run", step=0, max_steps=sim.max_steps, goal="object", questions_left=sim.max_questions,
-                 costs=tuple(costs), answers=(), last_move="", n_views=sim.n_views, view_fov=sim.view_hfov,
-                 panel=img,
-                 observation=None if img is not None else "\n".join(f"- view {k}: open floor for about 2.0 m; nothing of "
-                                                                     "note" for k in range(sim.n_views)),
-                 percept={})
-    memory = agent.start("dry-run")
-    req = agent.planner_request(memory, d) if hasattr(agent, "planner_request") else agent.request(memory, d)
-
-    def text_tokens(r) -> int:
-        chars = sum(len(p) if isinstance(p, str) else len(p.get("text", "")) if isinstance(p, dict) else 0
-                    for m in r.messages for p in ([m["content"]] if isinstance(m["content"], str) else m["content"]))
-        return chars // 4 + len(json.dumps(r.schema or {})) // 4
-
-    rows, cols, _ = panel_layout(sim.n_views)
-    panel_tokens = (rows * views.size // IMAGE_TOKEN_PX) * (cols * views.size // IMAGE_TOKEN_PX)
-    view_tokens = (views.size // IMAGE_TOKEN_PX) ** 2
-    decisions = n_episodes * sim.max_steps
-    planner_tokens = text_tokens(req) + (panel_tokens if img is not None else 0)
-    out = {"agent": agent.name, "episodes": n_episodes, "decisions_at_most": decisions,
-           "planner_requests": decisions, "grounder_requests": decisions if two_stage else 0,
-           "images": (decisions if img is not None else 0) + (decisions if two_stage else 0),
-           "prompt_tokens_per_planner_request": planner_tokens}
-    grounder_tokens = 0
-    if two_stage:
-        g = agent.grounder_request(d, ImagePart(b"\xff\xd8\xff\xd9"), "the centre of the open doorway", "")
-        grounder_tokens = text_tokens(g) + view_tokens
-        out["prompt_tokens_per_grounder_request"] = grounder_tokens
-    paraphrase_tokens = 0
-    if llm is not None and llm.paraphrase and agent.may_ask:  # one per answer; a question per decision at most
-        out["paraphrase_requests"] = n_episodes * min(sim.max_questions, sim.max_steps)
-        route = OT.route_text(0, 2, -1, False, ())
-        paraphrase_tokens = text_tokens(ChatRequest(messages=OT.paraphrase_messages(3, route),
-                                                    schema=OT.PARAPHRASE_SCHEMA))
-        out["prompt_tokens_per_paraphrase_request"] = paraphrase_tokens
-    out["requests"] = out["planner_requests"] + out["grounder_requests"] + out.get("paraphrase_requests", 0)
-    out["prompt_tokens"] = (decisions * planner_tokens + out["grounder_requests"] * grounder_tokens
-                            + out.get("paraphrase_requests", 0) * paraphrase_tokens)
-    max_tokens = (llm.max_tokens if llm is not None else LLMConfig().max_tokens)
-    out["completion_tokens_at_most"] = out["requests"] * max_tokens
-    return out
-
-
 def run_llm_agent(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, *, sim: T.SimConfig = T.SimConfig(),
                   views: ViewConfig = ViewConfig(), batch: int = 64, seed: int = 0, costs=LOCKED_COSTS,
                   out: str | os.PathLike | None = None, save_images: int = 0, progress: bool = False, world=None,
@@ -788,8 +688,9 @@ def run_llm_agent(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, *, sim: T.Sim
         costs: the question costs shown to a cost-aware agent.
         out: run folder for the checkpoint (``llm/<agent>.progress.jsonl``) and
             images; None: no checkpoint.
-        save_images: write the panels of the first N episodes to
-            ``images/<agent>/<episode id>/<step>_panel.jpg`` (for the viewer).
+        save_images: write the images of the first N episodes to
+            ``images/<agent>/<episode id>/<step>_panel.jpg`` and, for a Grounder,
+            ``<step>_grounder.jpg`` (for the viewer, which marks the chosen cell on it).
         progress: show a progress bar (episodes, ETA, requests in flight,
             tokens, retries).
         world: a :class:`~ignjax.sim.env.World` made from ``es`` (or the set it
@@ -822,23 +723,4 @@ def _paraphrase_reply(parsed, err):
     return " ".join(text.split()), None
 
 
-def question_texts(calls: list) -> list[dict]:
-    """The question texts of transcript records (``calls``: :attr:`LoopResult.transcripts`
-    or the lines of ``transcripts/<agent>.jsonl``): one ``{"episode": id, "step": s,
-    "type": t, "text": str}`` per ASK decision of an agent that writes its questions
-    ("" where it asked without one)."""
-    return [{"episode": c["episode"], "step": int(c["step"]), "type": int(c["action"][4]), "text": c["question"]}
-            for c in calls if "question" in c and c.get("action") and c["action"][0] == ASK]
-
-
-def write_transcripts(folder: str | os.PathLike, agent: str, calls: list) -> Path:
-    """``<folder>/transcripts/<agent>.jsonl``: one record per model call, sorted by
-    episode (file order) and step (:mod:`ignjax.view`'s transcript schema plus
-    request hash, image hashes, tokens, latency, cache hit)."""
-    path = Path(folder) / "transcripts" / f"{agent}.jsonl"
-    atomic_write(path, "".join(json.dumps(c, sort_keys=True) + "\n" for c in calls))
-    return path
-
-
-__all__ = ["ACCOUNTING", "HostLoop", "LoopResult", "observation_text", "question_texts", "run_llm_agent",
-           "write_transcripts"]
+__all__ = ["ACCOUNTING", "HostLoop", "LoopResult", "observation_text", "run_llm_agent"]

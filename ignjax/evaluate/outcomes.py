@@ -62,20 +62,23 @@ COLUMNS: tuple[str, ...] = (
     "agent", "episode_id", "scene_id", "difficulty", "final_distance", "final_euclidean", "min_distance",
     "path_length", "steps", "stopped", "stop_reason", "q1", "q2", "q3", "q4", "n_questions", "n_refused", "n_invalid",
     "trace", "requests", "cache_hits", "prompt_tokens", "completion_tokens", "cost_usd", "retries", "invalid_replies",
-    "paraphrase_rejected", "model_latency_s", "failure",
+    "refused_asks", "paraphrase_rejected", "model_latency_s", "failure",
 )
 ACCOUNTING_COLUMNS: tuple[str, ...] = ("requests", "cache_hits", "prompt_tokens", "completion_tokens", "retries",
-                                       "invalid_replies", "paraphrase_rejected", "model_latency_s", "failure")
-"""Model-call accounting of MLLM agents (:mod:`ignjax.evaluate.hostloop`): requests sent to a server (cache hits
-excluded), cache hits, tokens, HTTP retries, replies that could not be used, oracle answers whose paraphrase was
-refused (``llm.paraphrase``: the template was shown instead), seconds spent waiting on the model in this run, and
-why an episode ended by model failure ("" otherwise). Zero (and "") for JAX-native agents; optional when a table
-is read (older tables have none)."""
+                                       "invalid_replies", "refused_asks", "paraphrase_rejected", "model_latency_s",
+                                       "failure")
+"""Model-call accounting of MLLM agents (:mod:`ignjax.evaluate.accounting`): HTTP attempts sent to a server (every
+attempt, answered or not: timeouts and refused connections count; cache hits excluded), cache hits, tokens, HTTP
+retries, replies that could not be used, of those the replies that asked a question with none left (answered with
+a correction, never passed to the simulator, so not in ``n_refused``), oracle answers whose paraphrase was refused
+(``llm.paraphrase``: the template was shown instead), seconds spent waiting on the model in this run, and why an
+episode ended by model failure ("" otherwise). Zero (and "") for JAX-native agents; optional when a table is read
+(older tables have none)."""
 _ACCOUNTING_INTS = ("requests", "cache_hits", "prompt_tokens", "completion_tokens", "retries", "invalid_replies",
-                    "paraphrase_rejected")
+                    "refused_asks", "paraphrase_rejected")
 PER_EPISODE = ("calls", "prompt_tokens", "completion_tokens", "cost_usd")
-"""The per-episode figures of :func:`model_totals` (``calls``: requests sent plus cache hits, the episode's model
-calls whether or not the cache answered them, as its tokens and cost count them)."""
+"""The per-episode figures of :func:`model_totals` (``calls``: requests sent less their retries, plus cache hits:
+the episode's model calls whether or not the cache answered them, as its tokens and cost count them)."""
 
 
 def _trace(types, steps, charged) -> str:
@@ -151,7 +154,7 @@ def model_totals(rows: list[dict], prices: dict | None = None) -> dict[str, dict
         t["failures"] = sum(bool(r["failure"]) for r in rs)
         t["cost_usd"] = price(t["prompt_tokens"], t["completion_tokens"], prices)
         t["episodes"] = len(rs)
-        each = {"calls": [int(r["requests"]) + int(r["cache_hits"]) for r in rs],
+        each = {"calls": [int(r["requests"]) - int(r["retries"]) + int(r["cache_hits"]) for r in rs],
                 "prompt_tokens": [int(r["prompt_tokens"]) for r in rs],
                 "completion_tokens": [int(r["completion_tokens"]) for r in rs],
                 "cost_usd": [price(int(r["prompt_tokens"]), int(r["completion_tokens"]), prices) for r in rs]}

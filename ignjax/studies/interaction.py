@@ -63,7 +63,7 @@ Type-3 content (:func:`classify_question`, :func:`type3_content`)
     route requests, the spatial position of the goal room, relations
     between rooms). Only agents that write their questions have texts
     (TANDEM and the baselines built on it: the transcript's ``question``,
-    :func:`ignjax.evaluate.hostloop.question_texts`); for the others (the
+    :func:`ignjax.evaluate.accounting.question_texts`); for the others (the
     JAX-native agents, ``vlm``) the split is not applicable and no count is
     made. The classifier is a fixed list of patterns, tried on the
     lower-cased text with runs of spaces made one, in this order; the first

@@ -1,5 +1,12 @@
 """Command line of ``python -m ignjax.sweep``: its options, the study
-names ``--study`` accepts, and :func:`main`."""
+names ``--study`` accepts, and :func:`main`.
+
+Exit status: 0; 2 on an error (configuration, folder, the model server's
+check); 3 (:data:`ignjax.evaluate.recovery.MODEL_FAILURE_EXIT`) when an
+MLLM agent's episode ended by a model failure: the report and every output
+are written, a line on stderr says how many episodes of which agent ended
+so, and the same command with ``--resume`` runs them again (the replies
+they got come from the reply cache)."""
 
 from __future__ import annotations
 
@@ -25,7 +32,9 @@ def build_parser() -> argparse.ArgumentParser:
                "sweeps/default.toml. Examples:\n"
                "  python -m ignjax.sweep                       # everything, default sizes\n"
                "  python -m ignjax.sweep --study eval --quick --out /tmp/r\n"
-               "  python -m ignjax.sweep --set costs.samples=1000000 --set eval.agents='[\"eig\",\"random\"]'\n")
+               "  python -m ignjax.sweep --set costs.samples=1000000 --set eval.agents='[\"eig\",\"random\"]'\n"
+               "Exit status: 0; 2 on an error; 3 when an MLLM agent's episode ended by a model failure (outputs "
+               "written; --resume runs those episodes again).")
     p.add_argument("--study", action="append", default=[],
                    help=f"study to run: {', '.join(STUDIES)} or all (repeatable, or comma-separated; default all)")
     p.add_argument("--config", help="TOML file with [section] tables overriding the defaults (see sweeps/)")
@@ -90,13 +99,15 @@ def main(argv=None) -> int:
             from ignjax.devices.launch import launch
 
             return launch("ignjax.sweep", argv, popts.launch)
-        from ignjax.sweep.stages import run_sweep
+        from ignjax.evaluate.recovery import report_model_failures
+        from ignjax.sweep.stages import model_failures, run_sweep
 
         t0 = time.perf_counter()
-        run_sweep(cfg, studies, out, resume=args.resume, force=args.force, quiet=args.quiet, group=group)
-        if group.main:
-            print(f"wrote {out / 'report.md'} ({time.perf_counter() - t0:.0f} s)", file=sys.stderr)
-        return 0
+        results = run_sweep(cfg, studies, out, resume=args.resume, force=args.force, quiet=args.quiet, group=group)
+        if not group.main:
+            return 0
+        print(f"wrote {out / 'report.md'} ({time.perf_counter() - t0:.0f} s)", file=sys.stderr)
+        return report_model_failures(model_failures(results), "run the same command again with --resume")
     except IgnjaxError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2

@@ -363,14 +363,16 @@ def _section_eval(results: dict, es, rollouts: dict, cfg, out: Path) -> list[str
               "`python -m ignjax.view RUN_DIR` (this folder) rebuilds it, `--gif EPISODE_ID --agent NAME` exports "
               "one episode as an animation).", ""]
     if ev["model_totals"]:
-        parts += ["MLLM agents' model calls (requests sent to the server, cache hits excluded; tokens as the server "
-                  "counted them; cost from `llm.prices`); per-decision transcripts in `transcripts/<agent>.jsonl`:",
+        parts += ["MLLM agents' model calls (requests: every attempt sent to the server, answered or not, cache hits "
+                  "excluded; tokens as the server counted them; refused asks: questions asked with none left, "
+                  "corrected; cost from `llm.prices`); per-decision transcripts in `transcripts/<agent>.jsonl`:",
                   "", "| agent | requests | cache hits | prompt tokens | completion tokens | retries | invalid replies "
-                  "| ended by model failure | cost (USD) |", "|---|---|---|---|---|---|---|---|---|"]
+                  "| refused asks | ended by model failure | cost (USD) |", "|---|---|---|---|---|---|---|---|---|---|"]
         for name, t in ev["model_totals"].items():
             cost = "" if t["cost_usd"] is None else f"{t['cost_usd']:.4f}"
             parts.append(f"| {name} | {t['requests']} | {t['cache_hits']} | {t['prompt_tokens']} | "
-                         f"{t['completion_tokens']} | {t['retries']} | {t['invalid_replies']} | {t['failures']} | {cost} |")
+                         f"{t['completion_tokens']} | {t['retries']} | {t['invalid_replies']} | {t['refused_asks']} | "
+                         f"{t['failures']} | {cost} |")
         parts += ["", "Per episode (mean / max over the agent's episodes; model calls sent or answered from the cache, "
                   "whose tokens and cost count alike; per-episode figures also in the outcome table's `requests`, "
                   "`cache_hits`, `prompt_tokens`, `completion_tokens` and `cost_usd` columns):", "",

@@ -9,12 +9,14 @@ server, with the ``[views]`` observations, ``eval.batch`` episodes in
 flight, the charged ``eval.costs`` shown to it and ``run.seed``. Its
 checkpoint is the host loop's own (``<run>/llm/<agent>.progress.jsonl``,
 one line per finished episode), so ``--resume`` after a kill continues
-episode by episode. Before any work, every ``llm.endpoints`` URL is asked for
+episode by episode, and runs again the episodes that ended by a model
+failure (:mod:`ignjax.evaluate.recovery`; the command line then exits with
+status 3, :func:`model_failures`). Before any work, every ``llm.endpoints`` URL is asked for
 its models (:func:`ignjax.agents.llm.models.check_served`, not under
 ``llm.replay``): one that does not answer, or an ``llm.model`` it does not
 serve, is an error naming it. Replies are cached in ``llm.cache_dir`` (default
 ``<run>/llm_cache``), and transcripts go to ``<run>/transcripts/<agent>.jsonl``;
-the question texts the agent wrote (:func:`ignjax.evaluate.hostloop.question_texts`)
+the question texts the agent wrote (:func:`ignjax.evaluate.accounting.question_texts`)
 stay with its rollout for the analysis study."""
 
 from __future__ import annotations
@@ -123,7 +125,8 @@ def merge_stage(name: str, n_batches: int, ckpt: Checkpoints, store: PartStore, 
 
 def run_llm_stage(es, agent_name: str, cfg: SweepConfig, out: Path, bar=None, quiet: bool = False) -> dict:
     """Outcomes, trajectories and model-call accounting of one MLLM agent (module docstring)."""
-    from ignjax.evaluate.hostloop import question_texts, run_llm_agent, write_transcripts  # aiohttp, renderers
+    from ignjax.evaluate.accounting import question_texts, write_transcripts
+    from ignjax.evaluate.hostloop import run_llm_agent  # aiohttp, renderers
 
     llm = cfg.llm
     if llm.cache_dir is None:
@@ -131,12 +134,23 @@ def run_llm_stage(es, agent_name: str, cfg: SweepConfig, out: Path, bar=None, qu
     res = run_llm_agent(es, get_llm_agent(agent_name), llm, sim=cfg.sim, views=cfg.views, batch=cfg.eval.batch,
                         seed=cfg.run.seed, costs=cfg.eval.costs, out=out, progress=not quiet)
     write_transcripts(out, agent_name, res.transcripts)
+    if not quiet:
+        from ignjax.evaluate.accounting import run_line
+
+        print(run_line(agent_name, len(es), res.stats["wall_s"], res.stats), file=sys.stderr)
     if bar is not None:
         bar.update(len(es))
     acc = {k: np.asarray(v) for k, v in res.accounting.items() if k != "failure"}
     return {"out": _to_tree(res.outcomes), "traj": _to_tree(res.trajectories),
             "accounting": {**acc, "failure": list(res.accounting["failure"])}, "stats": res.stats,
             "questions": question_texts(res.transcripts)}
+
+
+def model_failures(results: dict) -> dict[str, list[str]]:
+    """Each MLLM agent's ``failure`` texts in a :func:`run_sweep` result, one per episode ("" where the episode
+    did not end by a model failure); {} when no MLLM agent ran."""
+    return {a: [str(f) for f in r["accounting"]["failure"]] for a, r in results.get("rollouts", {}).items()
+            if isinstance(r, dict) and "accounting" in r}
 
 
 def _costs_setup(cfg: SweepConfig):
@@ -339,4 +353,4 @@ def run_sweep(cfg: SweepConfig, studies: list[str], out: Path, *, resume: bool =
 
 
 __all__ = ["REPO_SCENES", "SHIPPED_BENCHMARK", "benchmark_path", "check_model_server", "load_episodes", "merge_stage",
-           "rollout_stage_parts", "run_llm_stage", "run_sweep"]
+           "model_failures", "rollout_stage_parts", "run_llm_stage", "run_sweep"]

@@ -51,7 +51,8 @@ Written by agents that see images or call models (optional; shown when present):
     episode id's ``/`` are folder separators
     (``images/eig/house_0_000/tv_stand_0/2/003_panel.jpg``). On the
     Grounder view the page marks the chosen MOVE's cell (column 1..8 left to
-    right, row 1..8 bottom to top).
+    right, row 1..8 bottom to top). ``<step>_grounder_<view>.<ext>`` (the
+    view's index added) is read as ``<step>_grounder.<ext>``.
 ``transcripts.jsonl`` and ``transcripts/*.jsonl``
     one JSON object per line, one line per model call, with the keys
     ``agent`` (str), ``episode`` (the episode id), ``step`` (int, 0-based
@@ -61,7 +62,9 @@ Written by agents that see images or call models (optional; shown when present):
     (str, the text sent), ``reply`` (str, the raw reply), ``parsed`` (any
     JSON value: the parse result, null when parsing failed), ``retries``
     (int, or a list of ``{"reply": str, "error": str}`` earlier attempts)
-    and ``error`` (str or null); other keys are ignored, and so are records
+    and ``error`` (str or null); a ``controller`` record may carry ``rule``
+    (str: the rule that decided) and ``text`` (str: what it asked or did),
+    shown with it; other keys are ignored, and so are records
     of agents or episodes the page does not hold. Calls are shown in file
     order. A line that is not such an object is an error naming the file
     and line.

@@ -31,8 +31,9 @@ from ignjax.scenes.model import Scene
 IMAGE_DIR = "images"
 TRANSCRIPT_FILE = "transcripts.jsonl"
 TRANSCRIPT_DIR = "transcripts"
-IMAGE_NAME = re.compile(r"^(\d+)_(panel|grounder)\.(jpg|jpeg|png)$", re.IGNORECASE)
-"""``<step>_<kind>.<ext>`` of an image file (see the module docstring of :mod:`ignjax.view`)."""
+IMAGE_NAME = re.compile(r"^(\d+)_(panel|grounder)(?:_\d+)?\.(jpg|jpeg|png)$", re.IGNORECASE)
+"""``<step>_<kind>.<ext>`` of an image file, or ``<step>_grounder_<view>.<ext>`` (the name runs wrote before the
+Grounder's image was named like the panel's; see the module docstring of :mod:`ignjax.view`)."""
 IMAGE_KINDS = ("panel", "grounder")
 TRANSCRIPT_KEYS = ("agent", "episode", "step", "role", "prompt", "reply", "parsed", "retries", "error")
 ROLES = ("planner", "grounder", "controller", "paraphrase")

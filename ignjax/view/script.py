@@ -345,6 +345,7 @@ function Panel(i, k, slot) {
         h("details", {}, h("summary", {text: "prompt (" + c.prompt.length + " characters)"}), h("pre", {cls: "prompt", text: c.prompt})),
         h("p", {text: "raw reply:"}), h("pre", {cls: "reply", text: c.reply}),
         h("p", {text: "parsed:"}), h("pre", {cls: "parsed", text: JSON.stringify(c.parsed, null, 1)}));
+      if (c.rule) box.append(h("p", {cls: "rule", text: "rule: " + c.rule + (c.text ? ": " + c.text : "")}));
       retries.forEach((x, j) => box.append(h("p", {cls: "muted", text: "retry " + (j + 1) + ": " + (x.error || "")}), h("pre", {text: x.reply || ""})));
       if (c.error) box.append(h("p", {cls: "error", text: "error: " + c.error}));
       detail.append(box);

@@ -93,7 +93,7 @@ def test_sweep_eval_runs_an_mllm_agent_and_reruns_from_the_cache(rendering, tmp_
         assert "| vlm |" in report and "| random |" in report
         tokens = [sum(int(r[k]) for r in vlm) for k in ("prompt_tokens", "completion_tokens")]
         cost = (tokens[0] * 0.5 + tokens[1] * 2.0) / 1e6
-        assert f"| vlm | {n_vlm} | 0 | {tokens[0]} | {tokens[1]} | 0 | 0 | 0 | {cost:.4f} |" in report
+        assert f"| vlm | {n_vlm} | 0 | {tokens[0]} | {tokens[1]} | 0 | 0 | 0 | 0 | {cost:.4f} |" in report
         # per episode: the outcome rows' cost column and the report's mean / max, both from the rows' tokens
         each = [(int(r["requests"]) + int(r["cache_hits"]), int(r["prompt_tokens"]), int(r["completion_tokens"]))
                 for r in vlm]

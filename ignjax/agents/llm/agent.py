@@ -28,6 +28,12 @@ correction and asked again (``reasks`` times); after that the agent takes
 its default action (:meth:`LLMAgent.default_action`: a short move straight
 ahead, the cell at column 4, row 1) and the reply counts as invalid.
 
+A question asked when none is left (the budget spent) is such a reply: it is
+answered with :data:`NO_QUESTIONS_LEFT` and asked again, never passed to the
+simulator, and the host loop counts it in the episode's ``refused_asks``
+(:mod:`ignjax.evaluate.accounting`); the prompt of a decision with no
+question left says so.
+
 The prompts are ours; they follow the paper's structure (role and task,
 action rules, the grid convention, the question types and their costs, the
 reply format; then the step's state and images).
@@ -46,6 +52,9 @@ MOVE, ASK, STOP = 0, 1, 2
 
 MOVED_M = 0.05
 """A MOVE that covered less than this (m) did not move: the way was blocked."""
+
+NO_QUESTIONS_LEFT = "you have no questions left (your question budget is spent); choose move or stop"
+"""The correction of a reply that asks with no question left (the host loop counts these as ``refused_asks``)."""
 
 QUESTION_NAMES = {1: "appearance", 2: "region", 3: "route", 4: "confirmation"}
 QUESTION_HELP = {
@@ -208,6 +217,8 @@ class LLMAgent:
             elif a == "ask":
                 if not self.may_ask:
                     return None, "this agent may not ask questions; choose move or stop"
+                if d.questions_left <= 0:
+                    return None, NO_QUESTIONS_LEFT
                 act = (ASK, 0, 4, 1, integer("question", 1, 4))
             else:
                 act = (STOP, 0, 4, 1, 1)
@@ -275,7 +286,8 @@ class VlmAgent(LLMAgent):
         answers = "\n".join(f"- ({QUESTION_NAMES[t]}) {text}" for t, text in d.answers) or "(no questions asked yet)"
         parts = [
             f"Find the {d.goal}.",
-            f"Turn {d.step + 1} of at most {d.max_steps}. Questions left: {d.questions_left}.",
+            f"Turn {d.step + 1} of at most {d.max_steps}. Questions left: {d.questions_left}."
+            + (" Your question budget is spent: do not ask; choose move or stop." if d.questions_left <= 0 else ""),
             f"What the helper has told you:\n{answers}",
             f"Your recent actions:\n{_history_text(memory, view_names(d.n_views))}",
         ]
@@ -298,5 +310,5 @@ class VlmAgent(LLMAgent):
                            schema=decision_schema(d.n_views), tag=d.episode)
 
 
-__all__ = ["ASK", "Decision", "EpisodeMemory", "LLMAgent", "MOVE", "MOVED_M", "QUESTION_NAMES", "STOP", "VlmAgent",
-           "decision_schema"]
+__all__ = ["ASK", "Decision", "EpisodeMemory", "LLMAgent", "MOVE", "MOVED_M", "NO_QUESTIONS_LEFT", "QUESTION_NAMES",
+           "STOP", "VlmAgent", "decision_schema"]

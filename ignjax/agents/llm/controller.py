@@ -62,7 +62,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from ignjax.agents.llm.agent import ASK, MOVE, QUESTION_NAMES, STOP, Decision
+from ignjax.agents.llm.agent import ASK, MOVE, NO_QUESTIONS_LEFT, QUESTION_HELP, QUESTION_NAMES, STOP, Decision
 from ignjax.scenes import vocab
 from ignjax.sim import types as T
 from ignjax.sim.views.compose import view_names
@@ -87,7 +87,7 @@ CORRECTIONS = {
     "subgoal": "a move needs a subgoal naming a place in that view",
     "no_questions": "questions are not available to you; choose move or stop",
     "no_route_questions": "route questions (type 3) are not available to you; ask another type or move",
-    "budget": "no questions are left; choose move or stop",
+    "budget": NO_QUESTIONS_LEFT,
     "follow_up_ask": "the helper has confirmed the target; make one closer move toward it, then stop",
     "known_fact": "the {fact} fact is already in the Fact Base; use it instead of asking again",
     "route": ("a route question is for a junction with several plausible ways, a loop back to where you have been, a "
@@ -198,20 +198,28 @@ class TandemController:
 
     def _controller(self, m: TandemMemory, d: Decision):
         """An action the controller takes without asking the model, or None."""
+        ruled = self._controller_rule(m, d)
+        return None if ruled is None else ruled[0]
+
+    def _controller_rule(self, m: TandemMemory, d: Decision):
+        """``(action, rule, what it did in words)`` when the controller decides without asking the model, or None
+        (the words go to the transcript's ``controller`` record, never to the model)."""
         p = d.percept
         if not self.safeguards:
             return None
         if p.get("confirm") == 1 and p.get("follow_up") == T.FOLLOW_STOP_NOW:
-            return (STOP, 0, 4, 1, 1)
+            return (STOP, 0, 4, 1, 1), "stop after confirmation", "the helper confirmed the target and said to stop now: stop"
         if not self.qa or d.questions_left <= 0 or (p.get("confirm") == 1 and p.get("follow_up") == T.FOLLOW_ONE_MOVE):
             return None
         t = self._early_question(m, d)
         if t is not None:
-            return (ASK, 0, 4, 1, t)
+            return (ASK, 0, 4, 1, t), "early question", (f"turn {d.step + 1} without the {QUESTION_NAMES[t]} fact: "
+                                                         f"ask it (type {t}, {QUESTION_HELP[t]})")
         if (self.route_questions and m.moves_since_hint >= RECOVERY_MOVES and not p.get("hint_active")
                 and not self._near_goal(m, d)):
-            m.moves_since_hint = 0
-            return (ASK, 0, 4, 1, 3)
+            moves, m.moves_since_hint = m.moves_since_hint, 0
+            return (ASK, 0, 4, 1, 3), "recovery", (f"{moves} moves without a route hint or a confirmed candidate: "
+                                                   f"ask a route question (type 3, {QUESTION_HELP[3]})")
         return None
 
     # -- on the Planner's decision ---------------------------------------------

@@ -388,8 +388,11 @@ class Tandem(TandemController, LLMAgent):
     async def decide(self, ctx, m: TandemMemory, d: Decision):
         self._observe_outcome(m, d)
         question = ""  # the Planner's question text; none when the controller asks (recovery, confirm before stop)
-        act = self._controller(m, d)
-        if act is None:
+        ruled = self._controller_rule(m, d)
+        if ruled is not None:
+            act = ruled[0]
+            ctx.note_rule(*ruled[1:])
+        else:
             plan = await ctx.query(self.planner_request(m, d), lambda parsed, err: self._parse_plan(m, d, parsed, err))
             if plan is None:
                 act = ctx.default(self.default_action(m, d))
@@ -401,6 +404,9 @@ class Tandem(TandemController, LLMAgent):
                     act = await self._ground(ctx, m, d, act, parsed)
                 elif act[0] == ASK and parsed.get("action") == "ask":  # not a stop turned into a confirmation
                     question = clip(parsed.get("question"))
+                elif act[0] == ASK:
+                    ctx.note_rule("confirm before stop", "the Planner chose stop without evidence (no confirmed "
+                                  "target, no hint that it is near): ask a confirmation question (type 4) instead")
         self._record(m, d, act, question)
         if act[0] == ASK and question:
             ctx.note_question(question)

@@ -355,7 +355,8 @@ def test_each_decision_path_end_to_end(episodes, tmp_path):
     assert res.outcomes.n_questions[0].tolist()[:2] == [1, 1] and res.outcomes.n_questions[0][3] == 1
     # Grounder images were saved beside the panels
     saved = sorted(x.name for x in (tmp_path / "images" / "tandem").rglob("*.jpg"))
-    assert any("grounder_2" in n for n in saved) and any("panel" in n for n in saved)
+    moved = [step for step, _, act in acts if act[0] == MOVE]
+    assert {f"{step:03d}_grounder.jpg" for step in moved} <= set(saved) and any("panel" in n for n in saved)
 
 
 SCHEDULE_SCRIPT = {1: _plan("move", direction="front", subgoal="the open doorway"),
