@@ -84,7 +84,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ignjax.agents.llm.agent import ASK, MOVE, MOVED_M, Decision, LLMAgent
+from ignjax.agents.llm.agent import ASK, MOVE, MOVED_M, Decision, LLMAgent, compass_degrees
 from ignjax.agents.llm.cache import ResponseCache
 from ignjax.agents.llm.client import ChatClient, ChatRequest, ImagePart, LLMRequestError
 from ignjax.agents.llm.config import LLMConfig
@@ -348,7 +348,8 @@ class HostLoop:
                 goal=vocab.category_display(rec["target_category"]), questions_left=int(qleft[r]),
                 costs=self.costs, answers=tuple(ep.answers),
                 last_move=" ".join(t for t in (_last_move_text(obs, r, last_kind), ep.progress) if t),
-                n_views=self.sim.n_views, view_fov=self.sim.view_hfov, observation=text, percept=percept)})
+                n_views=self.sim.n_views, view_fov=self.sim.view_hfov, observation=text, percept=percept,
+                heading=compass_degrees(pose[r][2]), offset=tuple(float(v) for v in obs["odometry"][r][:2]))})
         return out
 
     def _decisions(self, items: list[dict], slots) -> list[tuple[int, Decision]]:

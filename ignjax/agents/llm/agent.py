@@ -41,6 +41,8 @@ reply format; then the step's state and images).
 
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass, field
 
 from ignjax.agents.llm.client import ChatRequest, ImagePart
@@ -83,6 +85,22 @@ def decision_schema(n_views: int) -> dict:
     }
 
 
+def compass_degrees(yaw: float) -> float:
+    """A yaw (radians, counter-clockwise from the scene's +x axis, the
+    simulator's convention) as a compass heading in degrees [0, 360): 0
+    north (+y), 90 east (+x), 180 south, 270 west."""
+    return float((90.0 - math.degrees(float(yaw))) % 360.0)
+
+
+def orientation_text(d: "Decision") -> str:
+    """The Planner's own heading and offset from the start, in words (the paper's runtime-wrapper fields)."""
+    east, north = (float(v) for v in d.offset)
+    parts = [f"{abs(east):.1f} m {'east' if east >= 0 else 'west'}", f"{abs(north):.1f} m {'north' if north >= 0 else 'south'}"]
+    where = "at your start" if max(abs(east), abs(north)) < 0.05 else " and ".join(parts) + " of your start"
+    return (f"Heading of your front view: {round(d.heading) % 360} degrees (0 north, 90 east, 180 south, 270 west). "
+            f"Offset from start: {where}.")
+
+
 @dataclass(frozen=True)
 class Decision:
     """Everything an MLLM agent may read at one decision.
@@ -116,6 +134,13 @@ class Decision:
             ``hint_active``, ``hint_progress`` (:data:`ignjax.sim.types.HINT_*`),
             ``blocked`` (8,) bool sectors blocked in the last move, ``moved``
             metres the last move covered.
+        heading: the front view's compass heading, degrees in [0, 360): 0
+            north (the scene's +y axis), 90 east (+x), 180 south, 270 west
+            (:func:`compass_degrees` of the agent's yaw): the agent's own
+            orientation, which the paper's runtime wrapper gives the Planner.
+        offset: (east, north) metres the agent has moved since its start
+            (its own odometry, "offset from start" in the paper's Planner
+            inputs), not a coordinate of anything else.
     """
 
     episode: str
@@ -132,6 +157,8 @@ class Decision:
     views: object = None
     percept: dict = field(default_factory=dict)
     view_fov: float = 0.0
+    heading: float = 0.0
+    offset: tuple[float, float] = (0.0, 0.0)
 
     def __post_init__(self):
         if not self.view_fov:  # the panel's own width (:func:`ignjax.protocol.view_hfov`)

@@ -72,7 +72,8 @@ and a naive-QA form (``-naive``).
 
 from __future__ import annotations
 
-from ignjax.agents.llm.agent import ASK, MOVE, MOVED_M, QUESTION_HELP, QUESTION_NAMES, STOP, Decision, LLMAgent
+from ignjax.agents.llm.agent import (ASK, MOVE, MOVED_M, QUESTION_HELP, QUESTION_NAMES, STOP, Decision, LLMAgent,
+                                     orientation_text)
 from ignjax.agents.llm.client import ChatRequest
 from ignjax.agents.llm.controller import RECOVERY_MOVES, TEXT_CHARS, TandemController, TandemMemory, clip, rear
 from ignjax.sim import types as T
@@ -313,6 +314,7 @@ class Tandem(TandemController, LLMAgent):
         parts.append("Movement history: " + ("; ".join(hist) or "none yet"))
         if d.last_move and not (p.get("hint_active") and facts[3]):
             parts.append(f"Last move: {d.last_move}")
+        parts.append(orientation_text(d))
         parts.append(f"Turn {d.step + 1} of at most {d.max_steps}; questions left: {d.questions_left if self.qa else 0}.")
         parts.append(f"What you see:\n{d.observation}" if self.observation == "text" else "Your views follow.")
         return "\n\n".join(parts)

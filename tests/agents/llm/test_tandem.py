@@ -18,7 +18,7 @@ import jax
 import numpy as np
 import pytest
 
-from ignjax.agents.llm.agent import ASK, MOVE, STOP, Decision
+from ignjax.agents.llm.agent import ASK, MOVE, STOP, Decision, compass_degrees, orientation_text
 from ignjax.agents.llm.catalog import LLM_AGENTS, get_llm_agent
 from ignjax.agents.llm.config import LLMConfig
 from ignjax.agents.llm.serve import ScriptedServer, scripted_reply
@@ -322,6 +322,19 @@ def _script_policy(req: dict) -> str:
     return json.dumps(SCRIPT[turn])
 
 
+def test_compass_heading_and_offset_in_words():
+    """The Planner's own heading (0 north = the scene's +y, 90 east = +x) and offset from the start, as the paper's
+    runtime wrapper gives them; the simulator's yaw runs counter-clockwise from +x."""
+    import math
+
+    assert [compass_degrees(a) for a in (0.0, math.pi / 2, math.pi, -math.pi / 2)] == [90.0, 0.0, 270.0, 180.0]
+    d = dataclasses.replace(_decision(), heading=compass_degrees(math.radians(-45.0)), offset=(2.26, -1.04))
+    text = get_llm_agent("tandem").state_text(TandemMemory(), d)
+    assert orientation_text(d) in text
+    assert "Heading of your front view: 135 degrees (0 north, 90 east, 180 south, 270 west)" in text
+    assert "Offset from start: 2.3 m east and 1.0 m south of your start." in text
+
+
 @render_ok
 def test_each_decision_path_end_to_end(episodes, tmp_path):
     es = episodes.subset([0])
@@ -353,6 +366,13 @@ def test_each_decision_path_end_to_end(episodes, tmp_path):
     later = [c["prompt"] for c in p if c["step"] >= 2]
     assert all("appearance:" in t and "location:" in t for t in later)
     assert res.outcomes.n_questions[0].tolist()[:2] == [1, 1] and res.outcomes.n_questions[0][3] == 1
+    # the runtime wrapper's heading and offset from the start: the start pose's, then the agent's own odometry
+    yaw = es.records[0]["start"]["yaw"]
+    assert f"Heading of your front view: {round(compass_degrees(yaw)) % 360} degrees" in p[0]["prompt"]
+    assert "Offset from start: at your start." in p[0]["prompt"]
+    after = [c["prompt"] for c in p if c["step"] > acts[3][0]]  # after two moves
+    assert after and all(re.search(r"Offset from start: \d+\.\d m (east|west) and \d+\.\d m (north|south) of your start",
+                                   t) for t in after)
     # Grounder images were saved beside the panels
     saved = sorted(x.name for x in (tmp_path / "images" / "tandem").rglob("*.jpg"))
     moved = [step for step, _, act in acts if act[0] == MOVE]
