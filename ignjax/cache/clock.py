@@ -76,7 +76,6 @@ class CompileClock:
     def __init__(self):
         self.spans: list[tuple[float, float]] = []
         self.names: list[str] = []  # the programs obtained, in order (JAX's names, e.g. "jit(_run_sharded)")
-        self.programs = 0
         self.cache_hits = 0
         self._on = False
 
@@ -87,7 +86,6 @@ class CompileClock:
             if self._on and event in COMPILE_EVENTS:
                 self.spans.append((start, end))
                 if event == COMPILE_EVENTS[2]:
-                    self.programs += 1
                     self.names.append(str(kw.get("fun_name", "?")))
 
         def count(event, **_):
@@ -98,6 +96,11 @@ class CompileClock:
         jax.monitoring.register_event_listener(count)
         self._on = True
         return self
+
+    @property
+    def programs(self) -> int:
+        """Programs obtained (compiled or loaded from the cache) while started."""
+        return len(self.names)
 
     def stop(self) -> None:
         self._on = False  # JAX keeps the listeners; they do nothing from now on

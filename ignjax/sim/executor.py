@@ -33,16 +33,14 @@ def view_camera(cfg: T.SimConfig, pose, direction):
     field of view (``cfg.view_hfov``: 90 degrees for 4 and 8 views, 30 for
     12) on a ``cfg.image_size`` image with square pixels, looking along
     ``yaw + direction * 360 / n_views``, eye at ``eye_height``, pitch 0 (the
-    renderers' camera, :mod:`ignjax.sim.views.cameras`).
+    renderers' camera, :mod:`ignjax.sim.views.cameras`); the camera of
+    :func:`cell_ray`.
 
     Returns:
         (K, R_wc, t_wc): intrinsics (3, 3), camera-to-world rotation (3, 3), eye (3,).
     """
-    W, H = cfg.image_size
-    K = G.intrinsics(float(W), float(H), math.radians(cfg.view_hfov))
-    yaw = pose[2] + jnp.asarray(direction).astype(jnp.float32) * (2 * math.pi / cfg.n_views)
-    t_wc = jnp.array([pose[0], pose[1], cfg.eye_height], jnp.float32)
-    return K, G.view_rotation(yaw), t_wc
+    K, _, R_wc, t_wc, _ = cell_ray(cfg, pose, jnp.asarray(direction), 1, 1)
+    return K, R_wc, t_wc
 
 
 def cell_ray(cfg: T.SimConfig, pose, direction, col, row):
@@ -56,8 +54,6 @@ def cell_ray(cfg: T.SimConfig, pose, direction, col, row):
         (3,), whose projection on the optical axis is 1.
     """
     W, H = cfg.image_size
-    # view_camera's arithmetic, in the order the rollout programs have always traced it (their compiled forms
-    # are cached by the lowered program's text)
     K = G.intrinsics(float(W), float(H), math.radians(cfg.view_hfov))
     yaw = pose[2] + direction.astype(jnp.float32) * (2 * math.pi / cfg.n_views)
     uv = G.grid_to_pixel(col, row, float(W), float(H))

@@ -509,13 +509,7 @@ def rollout_memory(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.
     at run time (the CPU backend keeps no allocation statistics). Compiles
     the program (the compilation cache makes a later call with the same
     shapes free)."""
-    n = specs.scene.shape[0]
-    keys = _keys(keys, n)
-    fn, copies, out_axis = _rollout, 1, 0
-    if sweep:
-        fn, copies, out_axis = _rollout_sweep, jax.tree.leaves(params)[0].shape[0], 1
-    args, static, _ = _sharded_args(fn, world, specs, agent, params, keys, chunk, batch_parts(n, parts), copies,
-                                    out_axis)
+    args, static = rollout_call(world, specs, agent, params, keys, chunk, parts, sweep)
     m = _run_sharded.lower(*args, **static).compile().memory_analysis()
     arg, out, tmp = int(m.argument_size_in_bytes), int(m.output_size_in_bytes), int(m.temp_size_in_bytes)
     alias = int(getattr(m, "alias_size_in_bytes", 0))

@@ -96,18 +96,8 @@ def test_views_match_the_executor(house, rendered):
     bank, poses = house
     views = rendered.get("warp") or rendered["egl"]
     cfg = T.SimConfig()
-    world = World(bank, target_fields(bank, jnp.array([0]), jnp.array([0])), cfg)
-    cols, rows, us, vs = _cell_pixels()
-    n = len(cols)
-    P = np.repeat(poses, 8 * n, 0)
-    D = np.tile(np.repeat(np.arange(8), n), POSES)
-    C, Rw = np.tile(cols, 8 * POSES), np.tile(rows, 8 * POSES)
-    fn = jax.jit(jax.vmap(lambda p, d, c, r: X.cell_depth(world, jnp.int32(0), p, d, c, r)))
-    z, valid = (np.asarray(a) for a in fn(jnp.asarray(P), jnp.asarray(D, jnp.int32), jnp.asarray(C, jnp.int32),
-                                           jnp.asarray(Rw, jnp.int32)))
-    ri = np.repeat(np.arange(POSES), 8 * n)
-    rendered_z = views.depth[ri, D, np.tile(vs, 8 * POSES), np.tile(us, 8 * POSES)]
-    rendered_i = views.instance[ri, D, np.tile(vs, 8 * POSES), np.tile(us, 8 * POSES)]
+    P, D, C, Rw, z, valid, at = _executor_depth_at_cells(bank, poses, cfg)
+    rendered_z, rendered_i = views.depth[at], views.instance[at]
     assert valid.sum() > 100
     assert np.mean(np.abs(rendered_z[valid] - z[valid]) < 0.05) >= 0.95
     # the instance along each cell's ray, by MuJoCo's own ray caster
@@ -121,6 +111,23 @@ def test_views_match_the_executor(house, rendered):
                       np.array([1, 1, 1, 1, 0, 0], np.uint8), 1, -1, gid)
         hit_inst[i] = compiled.geom_instance[gid[0]] if gid[0] >= 0 else -1
     assert np.mean(hit_inst == rendered_i) >= 0.98
+
+
+def _executor_depth_at_cells(bank, poses, cfg):
+    """The executor's depth ray at every grid cell centre of every view of ``cfg`` at each pose: (pose, view,
+    column, row of each ray, depth, valid, index of the centre pixel into a rendered (pose, view, v, u) array)."""
+    nv = cfg.n_views
+    world = World(bank, target_fields(bank, jnp.array([0]), jnp.array([0])), cfg)
+    cols, rows, us, vs = _cell_pixels()
+    n = len(cols)
+    P = np.repeat(poses, nv * n, 0)
+    D = np.tile(np.repeat(np.arange(nv), n), POSES)
+    C, Rw = np.tile(cols, nv * POSES), np.tile(rows, nv * POSES)
+    fn = jax.jit(jax.vmap(lambda p, d, c, r: X.cell_depth(world, jnp.int32(0), p, d, c, r)))
+    z, valid = (np.asarray(a) for a in fn(jnp.asarray(P), jnp.asarray(D, jnp.int32), jnp.asarray(C, jnp.int32),
+                                           jnp.asarray(Rw, jnp.int32)))
+    at = (np.repeat(np.arange(POSES), nv * n), D, np.tile(vs, nv * POSES), np.tile(us, nv * POSES))
+    return P, D, C, Rw, z, valid, at
 
 
 def test_twelve_narrow_views_match_the_executor_and_tile(house):
@@ -140,17 +147,8 @@ def test_twelve_narrow_views_match_the_executor_and_tile(house):
         v = r.render(np.zeros(POSES, int), poses)
         assert r.panels(v).shape == (POSES, 3 * SIZE, 5 * SIZE, 3)
         assert r.grounder_images(v, np.array([0, 5, 11])).shape == (POSES, SIZE, SIZE, 3)
-    world = World(bank, target_fields(bank, jnp.array([0]), jnp.array([0])), cfg)
-    cols, rows, us, vs = _cell_pixels()
-    n = len(cols)
-    P = np.repeat(poses, 12 * n, 0)
-    D = np.tile(np.repeat(np.arange(12), n), POSES)
-    C, Rw = np.tile(cols, 12 * POSES), np.tile(rows, 12 * POSES)
-    fn = jax.jit(jax.vmap(lambda p, d, c, r: X.cell_depth(world, jnp.int32(0), p, d, c, r)))
-    z, valid = (np.asarray(a) for a in fn(jnp.asarray(P), jnp.asarray(D, jnp.int32), jnp.asarray(C, jnp.int32),
-                                           jnp.asarray(Rw, jnp.int32)))
-    ri = np.repeat(np.arange(POSES), 12 * n)
-    rendered_z = v.depth[ri, D, np.tile(vs, 12 * POSES), np.tile(us, 12 * POSES)]
+    _, _, _, _, z, valid, at = _executor_depth_at_cells(bank, poses, cfg)
+    rendered_z = v.depth[at]
     assert valid.sum() > 100
     assert np.mean(np.abs(rendered_z[valid] - z[valid]) < 0.05) >= 0.95
     left_edges = v.instance[:, :, :, 0]  # (R, 12, S): view k's leftmost column
