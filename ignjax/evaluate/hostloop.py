@@ -91,6 +91,7 @@ from ignjax.agents.llm.config import LLMConfig
 from ignjax.episodes.dataset import EpisodeSet
 from ignjax.errors import ConfigError
 from ignjax.evaluate import accounting as A
+from ignjax.evaluate import candidates as C
 from ignjax.evaluate.accounting import ACCOUNTING
 from ignjax.evaluate.recovery import ProgressLog
 from ignjax.fileio import atomic_write
@@ -113,6 +114,7 @@ class _Episode:
     progress: str = ""
     images: list = field(default_factory=list)
     unread: list = field(default_factory=list)  # indices into answers still to paraphrase (llm.paraphrase)
+    front: tuple | None = None  # what the pending decision showed of its front view, to resolve a Type-4 cell
 
 
 @dataclass
@@ -148,10 +150,13 @@ def _settings_hash(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, sim: T.SimCo
     return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
-def observation_text(obs: dict, r: int, categories: tuple[str, ...], names: tuple[str, ...]) -> str:
+def observation_text(obs: dict, r: int, categories: tuple[str, ...], names: tuple[str, ...], cells=None) -> str:
     """Row ``r`` of the symbolic observation as text (the ``text``
     observation of MLLM agents): per view, the free distance ahead and the
-    objects in sight with their perceived attributes."""
+    objects in sight with their perceived attributes; with ``cells`` (K, 2)
+    (:func:`ignjax.evaluate.candidates.front_cells`), the front-view grid
+    cell of each object that appears in the front view (what a Type-4
+    question names)."""
     lines = []
     fs = obs["free_space"][r]
     handles, cats, views, ranges, attrs = (obs[k][r] for k in ("visible_handle", "visible_category", "visible_view",
@@ -162,7 +167,9 @@ def observation_text(obs: dict, r: int, categories: tuple[str, ...], names: tupl
             words = [vocab.attribute_word(a, int(attrs[j, a])) for a in range(4) if attrs[j, a] >= 0]
             words = [w for w in words if w]
             cat = vocab.category_display(categories[int(cats[j])]) if 0 <= cats[j] < len(categories) else "object"
-            seen.append(f"{' '.join(words + [cat])} (object {int(handles[j])}, about {float(ranges[j]):.1f} m)")
+            where = (f", front view column {int(cells[j, 0])} row {int(cells[j, 1])}"
+                     if cells is not None and cells[j, 0] > 0 else "")
+            seen.append(f"{' '.join(words + [cat])} (object {int(handles[j])}, about {float(ranges[j]):.1f} m{where})")
         name = names[k] if k < len(names) else f"view {k}"
         lines.append(f"- {name}: open floor for about {float(fs[k].min()):.1f} m; "
                      + (f"you see {', '.join(seen)}" if seen else "nothing of note"))
@@ -298,6 +305,8 @@ class HostLoop:
         self.keys = episode_keys(seed, es.key_index)
         self.names = self._view_names()
         self.categories = es.bank.categories
+        self._structural = np.asarray(es.bank.instances.structural)
+        self._centers = np.asarray(es.bank.instances.center)
         self.renderer, self._own_renderer = None, False
         if agent.observation == "panel" and renderer is not None:
             if renderer.bank is not es.bank or renderer.sim != sim or renderer.config != views:
@@ -341,9 +350,14 @@ class HostLoop:
                        "hint_progress": int(ans.hint_progress[r]), "blocked": obs["blocked"][r].tolist(),
                        "moved": float(obs["last_move"][r])}
             rec = self.es.records[ep.index]
-            text = None if self.agent.observation == "panel" else observation_text(obs, r, self.categories, self.names)
+            text = front = None
+            if self.agent.observation == "text":  # the objects in sight, placed in front-view cells (Type-4 candidates)
+                handles = obs["visible_handle"][r]
+                cells = C.front_cells(self.sim, pose[r], self._centers[scene[r]][np.maximum(handles, 0)])
+                front = ("projection", cells, handles, obs["visible_range"][r])
+                text = observation_text(obs, r, self.categories, self.names, cells)
             last_kind = ep.calls[-1]["action"][0] if ep.calls and ep.calls[-1].get("action") else -1
-            out.append({"row": r, "scene": int(scene[r]), "pose": pose[r].copy(), "decision": dict(
+            out.append({"row": r, "scene": int(scene[r]), "pose": pose[r].copy(), "front": front, "decision": dict(
                 episode=rec["episode_id"], step=int(step[r]), max_steps=self.sim.max_steps,
                 goal=vocab.category_display(rec["target_category"]), questions_left=int(qleft[r]),
                 costs=self.costs, answers=tuple(ep.answers),
@@ -354,7 +368,7 @@ class HostLoop:
 
     def _decisions(self, items: list[dict], slots) -> list[tuple[int, Decision]]:
         """``(row, Decision)`` of prepared ``items`` (render, compose and encode their panels)."""
-        panels = [None] * len(items)
+        panels, v = [None] * len(items), None
         if self.agent.observation == "panel" and items:
             from ignjax.sim.views.encode import encode_images
 
@@ -368,8 +382,9 @@ class HostLoop:
         else:
             rgb = [None] * len(items)
         out = []
-        for it, panel, views in zip(items, panels, rgb):
+        for i, (it, panel, views) in enumerate(zip(items, panels, rgb)):
             ep = slots[it["row"]]
+            ep.front = ("segmentation", v.instance[i, 0], it["scene"]) if v is not None else it["front"]
             d = Decision(panel=panel, views=views, **it["decision"])
             if panel is not None and ep.index < self.save_images:
                 ep.images.append((d.step, panel, "panel"))
@@ -441,6 +456,52 @@ class HostLoop:
         ep.calls.append(A.call_record(self.agent.name, d, req, res, None, earlier[:-1],
                                       f"invalid replies: {earlier[-1]['error']}", role=role))
         return None
+
+    # -- applying the replies ---------------------------------------------------
+    def _actions(self, ready: dict, slots):
+        """The batch's :class:`~ignjax.sim.types.Action` from this round's replies ``ready`` (row ->
+        ``("act", tuple)`` or ``("fail", reason)``), with the Type-4 candidates resolved
+        (:mod:`ignjax.evaluate.candidates`): ``(action, acts (B, 5), candidates (B,), step_mask, fail_mask)``."""
+        B = self.B
+        acts = np.zeros((B, 5), np.int32)
+        acts[:, 3] = 1
+        acts[:, 4] = 1
+        cand = np.full(B, T.ANY_CANDIDATE, np.int32)
+        step_mask, fail_mask = np.zeros(B, bool), np.zeros(B, bool)
+        for r, (what, value) in ready.items():
+            if what == "act":
+                acts[r] = value
+                step_mask[r] = True
+                if acts[r, 0] == ASK and acts[r, 4] == 4:
+                    cand[r] = self._candidate(slots[r], int(acts[r, 2]), int(acts[r, 3]))
+            else:
+                fail_mask[r] = True
+                slots[r].failure = value
+        action = T.Action(kind=jnp.asarray(acts[:, 0]), direction=jnp.asarray(acts[:, 1]), col=jnp.asarray(acts[:, 2]),
+                          row=jnp.asarray(acts[:, 3]), question=jnp.asarray(acts[:, 4]), candidate=jnp.asarray(cand))
+        return action, acts, cand, step_mask, fail_mask
+
+    def _candidate(self, ep: _Episode, col: int, row: int) -> int:
+        """The instance a Type-4 question about front-view cell ``(col, row)`` asks about, from what the
+        decision was shown: the rendered segmentation, or the objects in sight placed in cells."""
+        if ep.front is None:
+            return T.NO_CANDIDATE
+        if ep.front[0] == "segmentation":
+            return C.segmented_candidate(ep.front[1], self._structural[ep.front[2]], col, row)
+        return C.projected_candidate(*ep.front[1:], col, row)
+
+    def _answer(self, ep: _Episode, q: int, answers, r: int, step: int, pointed: bool) -> None:
+        """Append the oracle's answer to a question of type ``q`` in words (row ``r`` of ``answers``)."""
+        er = self.es.records[ep.index]
+        txt = OT.answer_text(
+            q, bool(answers.refused[r]), appearance=er["oracle"]["appearance"], region=er["oracle"]["region"],
+            hint_room_label=int(answers.hint_room_label[r]), hint_sector=int(answers.hint_sector[r]),
+            hint_landmark=int(answers.hint_landmark[r]), hint_in_room=bool(answers.hint_in_room[r]),
+            confirm=int(answers.confirm[r]), follow_up=int(answers.follow_up[r]), categories=self.categories,
+            key=f"{er['episode_id']}:{step}", pointed=pointed)
+        ep.answers.append((q, txt))
+        if self.llm.paraphrase and not answers.refused[r]:
+            ep.unread.append(len(ep.answers) - 1)
 
     # -- the loop -------------------------------------------------------------
     async def run(self) -> LoopResult:
@@ -524,23 +585,9 @@ class HostLoop:
                     ready = {tasks.pop(t): t.result() for t in done if t in tasks}
                     if not ready:
                         continue
-                    acts = np.zeros((B, 5), np.int32)
-                    acts[:, 3] = 1
-                    acts[:, 4] = 1
-                    step_mask = np.zeros(B, bool)
-                    fail_mask = np.zeros(B, bool)
-                    for r, (what, value) in ready.items():
-                        if what == "act":
-                            acts[r] = value
-                            step_mask[r] = True
-                        else:
-                            fail_mask[r] = True
-                            slots[r].failure = value
+                    action, acts, cand, step_mask, fail_mask = self._actions(ready, slots)
                     decisions += int(step_mask.sum())
                     before_step = await loop.run_in_executor(None, np.asarray, states.step)
-                    action = T.Action(kind=jnp.asarray(acts[:, 0]), direction=jnp.asarray(acts[:, 1]),
-                                      col=jnp.asarray(acts[:, 2]), row=jnp.asarray(acts[:, 3]),
-                                      question=jnp.asarray(acts[:, 4]), candidate=jnp.full(B, -1, jnp.int32))
                     states, rec = await loop.run_in_executor(None, self._step, states, action, jnp.asarray(step_mask))
                     if fail_mask.any():
                         states = await loop.run_in_executor(None, self._abort, states, jnp.asarray(fail_mask))
@@ -551,18 +598,8 @@ class HostLoop:
                         ep = slots[r]
                         traj_rows[ep.index].append((int(before_step[r]), pose[r], [x[r] for x in rec]))
                         if acts[r, 0] == ASK:
-                            q = int(acts[r, 4])
-                            er = self.es.records[ep.index]
-                            txt = OT.answer_text(
-                                q, bool(answers.refused[r]), appearance=er["oracle"]["appearance"],
-                                region=er["oracle"]["region"], hint_room_label=int(answers.hint_room_label[r]),
-                                hint_sector=int(answers.hint_sector[r]), hint_landmark=int(answers.hint_landmark[r]),
-                                hint_in_room=bool(answers.hint_in_room[r]), confirm=int(answers.confirm[r]),
-                                follow_up=int(answers.follow_up[r]), categories=self.categories,
-                                key=f"{er['episode_id']}:{int(before_step[r])}")
-                            ep.answers.append((q, txt))
-                            if self.llm.paraphrase and not answers.refused[r]:
-                                ep.unread.append(len(ep.answers) - 1)
+                            self._answer(ep, int(acts[r, 4]), answers, r, int(before_step[r]),
+                                         pointed=int(cand[r]) != T.NO_CANDIDATE)
                         elif acts[r, 0] == MOVE:
                             ep.progress = OT.hint_progress_text(int(answers.hint_progress[r])) \
                                 if answers.hint_active[r] else ""

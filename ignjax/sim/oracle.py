@@ -129,7 +129,7 @@ def ask(world: World, state: T.SimState, qtype, candidate) -> T.SimState:
     label3, sector3, land3, inroom3, point3 = route_facts(world, ep, state.pose)
     # Type 4
     vis = target_visible_front(world, ep, state.pose)
-    yes = vis & ((candidate < 0) | (candidate == ep.target))
+    yes = vis & ((candidate == T.ANY_CANDIDATE) | (candidate == ep.target))
     close = geodesic_to_target(world, ep, state.pose[:2]) <= cfg.stop_radius
     follow = jnp.where(yes, jnp.where(close, T.FOLLOW_STOP_NOW, T.FOLLOW_ONE_MOVE), T.FOLLOW_NONE)
 

@@ -95,8 +95,12 @@ def route_text(room_label: int, sector: int, landmark: int, in_room: bool, categ
                   f"Go {way}, in the direction of the {room}{past}."), key)
 
 
-def confirm_text(answer: int, follow_up: int, key: str = "") -> str:
-    """Type 4: yes/no with a short reason and the follow-up instruction."""
+def confirm_text(answer: int, follow_up: int, key: str = "", pointed: bool = True) -> str:
+    """Type 4: yes/no with a short reason and the follow-up instruction;
+    ``pointed`` False: the question pointed at no object (a no with that reason)."""
+    if not pointed:
+        return _pick(("No: there is no object at the place you asked about.",
+                      "No. Nothing there is an object that could be checked."), key)
     if answer == 1:
         if follow_up == T.FOLLOW_STOP_NOW:
             return _pick(("Yes, that is the one, and you are close enough: stop here.",
@@ -114,7 +118,7 @@ def refused_text() -> str:
 
 def answer_text(question: int, refused: bool, *, appearance: str, region: str, hint_room_label: int = -1,
                 hint_sector: int = 0, hint_landmark: int = -1, hint_in_room: bool = False, confirm: int = -1,
-                follow_up: int = 0, categories: tuple[str, ...] = (), key: str = "") -> str:
+                follow_up: int = 0, categories: tuple[str, ...] = (), key: str = "", pointed: bool = True) -> str:
     """The oracle's answer to one question of type ``question`` (1..4) in
     words, from the episode's texts (Type 1: its description, Type 2: its
     goal region) and the answer's array facts (Types 3 and 4); the refusal
@@ -129,7 +133,7 @@ def answer_text(question: int, refused: bool, *, appearance: str, region: str, h
     if question == 3:
         return route_text(hint_room_label, hint_sector, hint_landmark, hint_in_room, categories, key)
     if question == 4:
-        return confirm_text(confirm, follow_up, key)
+        return confirm_text(confirm, follow_up, key, pointed)
     return ""
 
 

@@ -40,6 +40,11 @@ failing and the host loop ended the episode (it counts as a failure)."""
 HINT_NONE, HINT_CLOSER, HINT_SAME, HINT_FARTHER, HINT_REACHED, HINT_STOP = 0, 1, 2, 3, 4, 5
 HINT_PROGRESS = ("none", "closer", "no_change", "farther", "reached", "stop_eligible")
 FOLLOW_NONE, FOLLOW_STOP_NOW, FOLLOW_ONE_MOVE = 0, 1, 2
+ANY_CANDIDATE, NO_CANDIDATE = -1, -2
+"""Type-4 candidates that are no instance: ``ANY_CANDIDATE`` asks about
+whatever is in front (scripted agents; yes when the target is visible in
+front within range), ``NO_CANDIDATE`` is a question that pointed at no
+object (the answer is no: :mod:`ignjax.evaluate.candidates`)."""
 N_VIEWS = protocol.N_VIEWS
 N_QTYPES = protocol.N_QUESTION_TYPES
 
@@ -213,7 +218,9 @@ class Action:
         row: () grid row 1..8 (bottom to top) for MOVE.
         question: () question type 1..4 for ASK.
         candidate: () for Type 4: an instance handle from the observation's
-            visible list, or -1 for "what is in front of me".
+            visible list, :data:`ANY_CANDIDATE` (-1) for "what is in front
+            of me", or :data:`NO_CANDIDATE` (-2) for a question that pointed
+            at no object (answered no).
     """
 
     kind: jax.Array
@@ -557,7 +564,8 @@ class Trajectory:
             cell (column and row 1..8), as executed (clamped into range);
             -1 for other steps.
         candidate: (S,) int32 the instance handle a Type-4 question asked
-            about (-1: "what is in front of me", and for other steps).
+            about (-1: "what is in front of me", and for other steps; -2: the
+            question pointed at no object).
         waypoint: (S, 2) float32 the executor's waypoint of a MOVE (world);
             the pose before the step for other steps.
         blocked: (S, 8) bool headings (relative to the yaw before the MOVE,

@@ -286,6 +286,9 @@ def test_type4_yes_only_for_the_target_in_front_within_range(small_benchmark, sm
         assert int(same.answers.confirm) == 1
         other = fns["step"](small_world, st, T.Action.make(T.ASK, question=4, candidate=int(spec.target) + 1))
         assert int(other.answers.confirm) == 0 and int(other.answers.follow_up) == T.FOLLOW_NONE
+        # a question that pointed at no object: no, charged like any Type-4 question
+        none = fns["step"](small_world, st, T.Action.make(T.ASK, question=4, candidate=T.NO_CANDIDATE))
+        assert int(none.answers.confirm) == 0 and int(none.n_questions[3]) == 1
         behind = fns["reset"](small_world, dataclasses.replace(spec, start=spec.start.at[2].add(math.pi)))
         assert int(fns["step"](small_world, behind, T.Action.make(T.ASK, question=4)).answers.confirm) == 0
         checked += 1

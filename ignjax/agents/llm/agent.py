@@ -17,7 +17,9 @@ The reply is one JSON object (:func:`decision_schema`)::
     {"action": "move" | "ask" | "stop",
      "direction": view index 0..N-1 (MOVE: the view to move in),
      "col": 1..8, "row": 1..8      (MOVE: the grid cell on that view;
-                                    columns left to right, rows bottom to top),
+                                    columns left to right, rows bottom to top;
+                                    ASK type 4: the cell of the front view
+                                    showing the object asked about),
      "question": 1..4              (ASK: the question type),
      "reason": short free text}
 
@@ -63,7 +65,7 @@ QUESTION_HELP = {
     1: "what the target looks like (colour, material, size, state, what it stands on or near)",
     2: "which room the target is in and what it is near",
     3: "which way to go from here (a coarse route hint toward the goal)",
-    4: "whether the object straight in front of you is the target",
+    4: "whether one object in your front view is the target (the helper answers about that object only)",
 }
 
 
@@ -246,7 +248,9 @@ class LLMAgent:
                     return None, "this agent may not ask questions; choose move or stop"
                 if d.questions_left <= 0:
                     return None, NO_QUESTIONS_LEFT
-                act = (ASK, 0, 4, 1, integer("question", 1, 4))
+                q = integer("question", 1, 4)
+                # type 4 names its candidate by a cell of the front view (ignjax.evaluate.candidates)
+                act = (ASK, 0, integer("col", 1, 8), integer("row", 1, 8), 4) if q == 4 else (ASK, 0, 4, 1, q)
             else:
                 act = (STOP, 0, 4, 1, 1)
         except ValueError as e:
@@ -301,6 +305,8 @@ class VlmAgent(LLMAgent):
             "rows 1-8 run bottom to top; rows 1-3 are the floor in front of you, higher rows lie further away.\n"
             "- ask: put one question to a helper who knows where the target is. Question types:\n"
             f"{qs}\n"
+            "  For type 4, 'col' and 'row' name the cell of your front view (view 0) that shows the object you "
+            "ask about; the helper answers about that object only.\n"
             "  Every question lowers your final score" + (" by its cost" if self.show_costs else "")
             + ", so ask only when the answer will change what you do.\n"
             "- stop: end the episode when you are next to the target (within about a metre and a half).\n"

@@ -84,6 +84,8 @@ MEMORY_ITEMS = 6
 """Entries kept per Spatial Memory list."""
 GROUNDER_FALLBACK = (4, 2)
 """Cell taken when no Grounder reply is usable: centre column, near floor."""
+CANDIDATE_FALLBACK = (4, 4)
+"""Candidate cell of a Type-4 question when no Grounder reply is usable: the front view's middle."""
 
 
 def planner_schema(names: tuple[str, ...], actions=("move", "ask", "stop"), questions=(1, 2, 3, 4)) -> dict:
@@ -244,8 +246,11 @@ class Tandem(TandemController, LLMAgent):
                 + "You cannot ask questions: the target's description is given in the Fact Base. Stop when you are "
                 "next to the target. Avoid going back and forth.")
         cell = (" and 'col', 'row': the cell of the grid on that view to walk toward (columns 1-8 left to right, "
-                "rows 1-8 bottom to top; rows 1-3 are the floor ahead, higher rows lie further away or on walls)"
-                if not self.two_stage else "")
+                "rows 1-8 bottom to top; rows 1-3 are the floor ahead, higher rows lie further away or on walls); "
+                "for a confirmation question (type 4), the cell of your front view that shows the object you ask "
+                "about" if not self.two_stage else
+                "; for a confirmation question (type 4), 'subgoal' names the object you ask about, which must be in "
+                "your front view (a stop without confirmation becomes such a question about your subgoal)")
         blocks.append(
             # block 4: output contract
             "Reply with one JSON object and nothing else, with every key present: 'reasoning' (short), 'task_phase' "
@@ -345,6 +350,16 @@ class Tandem(TandemController, LLMAgent):
         return ChatRequest(messages=[{"role": "system", "content": system}, {"role": "user", "content": [text, image]}],
                            schema=GROUNDER_SCHEMA, schema_name="grounder_cell", tag=d.episode)
 
+    def candidate_request(self, d: Decision, image, what: str) -> ChatRequest:
+        """The Grounder's request for the cell of the object a confirmation question asks about."""
+        system = ("You locate one object in one camera view covered by a numbered 8x8 grid. Columns 1-8 run left to "
+                  "right, rows 1-8 from the bottom edge up. Find the object described and pick the cell that shows "
+                  "the object itself (its middle, not the floor in front of it or the wall behind it). Reply with one "
+                  'JSON object: {"col": 1-8, "row": 1-8, "rationale": "<a few words>"}.')
+        text = f"Object to check: {what}\nCurrent front view:"
+        return ChatRequest(messages=[{"role": "system", "content": system}, {"role": "user", "content": [text, image]}],
+                           schema=GROUNDER_SCHEMA, schema_name="candidate_cell", tag=d.episode)
+
     # -- memory updates ------------------------------------------------------
     def _merge(self, m: TandemMemory, d: Decision, parsed: dict) -> None:
         m.last_purpose = clip(parsed.get("purpose"))
@@ -404,6 +419,8 @@ class Tandem(TandemController, LLMAgent):
                 self._merge(m, d, parsed)
                 if act[0] == MOVE:
                     act = await self._ground(ctx, m, d, act, parsed)
+                elif act[0] == ASK and act[4] == 4:
+                    act = await self._ground_candidate(ctx, d, act, parsed)
                 elif act[0] == ASK and parsed.get("action") == "ask":  # not a stop turned into a confirmation
                     question = clip(parsed.get("question"))
                 elif act[0] == ASK:
@@ -420,11 +437,11 @@ class Tandem(TandemController, LLMAgent):
         act, why = self._check(m, d, parsed)
         if act is None:
             return None, why
-        if act[0] == MOVE and not self.two_stage:
+        if not self.two_stage and (act[0] == MOVE or (act[0] == ASK and act[4] == 4)):
             cell, why = _cell(parsed, None)
             if cell is None:
                 return None, why
-            act = (MOVE, act[1], *cell, 1)
+            act = (MOVE, act[1], *cell, 1) if act[0] == MOVE else (ASK, 0, *cell, 4)
         return (act, parsed), None
 
     async def _ground(self, ctx, m: TandemMemory, d: Decision, act, parsed):
@@ -435,6 +452,17 @@ class Tandem(TandemController, LLMAgent):
         got = await ctx.query(req, _cell, role="grounder")
         col, row = got if got is not None else GROUNDER_FALLBACK
         return (MOVE, k, col, row, 1)
+
+    async def _ground_candidate(self, ctx, d: Decision, act, parsed):
+        """A Type-4 question's candidate cell on the front view (:mod:`ignjax.evaluate.candidates`): the
+        Grounder finds the object the Planner named ('subgoal', else its question, else the goal); one-stage
+        agents named the cell themselves."""
+        if not self.two_stage:
+            return act
+        what = clip(parsed.get("subgoal")) or clip(parsed.get("question")) or f"the {d.goal}"
+        got = await ctx.query(self.candidate_request(d, ctx.view_image(0), what), _cell, role="grounder")
+        col, row = got if got is not None else CANDIDATE_FALLBACK
+        return (ASK, 0, col, row, 4)
 
     def _record(self, m: TandemMemory, d: Decision, act, question: str = "") -> None:
         names = view_names(d.n_views)

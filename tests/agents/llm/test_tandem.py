@@ -307,13 +307,26 @@ SCRIPT = {1: _plan("ask", question_type=1), 2: _plan("ask", question_type=1),
 evidence (turned into a confirmation); a stop right after the "no" (corrected, then a move)."""
 CELLS = {"the open doorway": (1, 1), "the corner by the window": (8, 8), "the middle of the room": (4, 2)}
 """The Grounder's cells, by subgoal (grid corners)."""
+CANDIDATE = (5, 4)
+"""The Grounder's cell of a Type-4 question's candidate."""
+
+
+def _grounded(req: dict, text: str) -> str | None:
+    """The Grounder's reply: a navigation cell by subgoal, or the candidate cell; None for a Planner request."""
+    name = req["response_format"]["json_schema"]["name"]
+    if name == "candidate_cell":
+        assert "Object to check:" in text
+        return json.dumps({"col": CANDIDATE[0], "row": CANDIDATE[1], "rationale": "scripted"})
+    if name == "grounder_cell":
+        col, row = CELLS[re.search(r"Navigation instruction: (.*)", text).group(1).strip()]
+        return json.dumps({"col": col, "row": row, "rationale": "scripted"})
+    return None
 
 
 def _script_policy(req: dict) -> str:
     text = _texts(req)
-    if req["response_format"]["json_schema"]["name"] == "grounder_cell":
-        col, row = CELLS[re.search(r"Navigation instruction: (.*)", text).group(1).strip()]
-        return json.dumps({"col": col, "row": row, "rationale": "scripted"})
+    if (grounded := _grounded(req, text)) is not None:
+        return grounded
     turn = int(re.search(r"Turn (\d+) of", text).group(1))
     if "already in the Fact Base" in text:  # the correction after the repeated Type-1 question
         return json.dumps(_plan("ask", question_type=2))
@@ -348,17 +361,18 @@ def test_each_decision_path_end_to_end(episodes, tmp_path):
     # T1, T2 (after the correction), move, move, confirmation (the unconfirmed stop), then the final decision
     assert [a[2][4] for a in acts[:2]] == [1, 2] and kinds[:2] == [ASK, ASK]
     assert acts[2][2][:4] == [MOVE, 2, 1, 1] and acts[3][2][:4] == [MOVE, 7, 8, 8]  # view and the Grounder's cells
-    assert acts[4][2] == [ASK, 0, 4, 1, 4]
+    assert acts[4][2] == [ASK, 0, *CANDIDATE, 4]  # the confirmation names the Grounder's candidate cell
     # the Planner's question texts reach the transcript; the stop turned into a confirmation has none
     assert [c["question"] for c in calls if c["action"] and c["action"][0] == ASK] == ["?", "?", ""]
     assert all("question" not in c for c in calls if c["action"] and c["action"][0] != ASK)
     assert acts[5][2][:2] == [MOVE, 0]  # the stop right after the "no", corrected into a move
     assert res.accounting["invalid_replies"].tolist() == [2]  # the repeated Type-1 question, that stop
     roles = [c["role"] for c in calls]
-    assert roles.count("grounder") == 3 and bodies == res.accounting["requests"].sum()
-    # the Grounder saw one image (the selected view) and the subgoal; the Planner the panel
+    assert roles.count("grounder") == 4 and bodies == res.accounting["requests"].sum()
+    # the Grounder saw one image (the selected view, the front view for the candidate) and the subgoal; the
+    # Planner the panel
     g = [c for c in calls if c["role"] == "grounder"]
-    assert [len(c["images"]) for c in g] == [1, 1, 1]
+    assert [len(c["images"]) for c in g] == [1, 1, 1, 1] and "Object to check:" in g[2]["prompt"]
     assert "the open doorway" in g[0]["prompt"] and "the corner by the window" in g[1]["prompt"]
     p = [c for c in calls if c["role"] == "planner"]
     assert all(len(c["images"]) == 1 for c in p)
@@ -388,9 +402,8 @@ SCHEDULE_SCRIPT = {1: _plan("move", direction="front", subgoal="the open doorway
 
 def _schedule_policy(req: dict) -> str:
     text = _texts(req)
-    if req["response_format"]["json_schema"]["name"] == "grounder_cell":
-        col, row = CELLS[re.search(r"Navigation instruction: (.*)", text).group(1).strip()]
-        return json.dumps({"col": col, "row": row, "rationale": "scripted"})
+    if (grounded := _grounded(req, text)) is not None:
+        return grounded
     if CORRECTIONS["stop_after_no"] in text:  # a move that gets somewhere on this episode
         return json.dumps(_plan("move", direction="right", subgoal="the middle of the room"))
     return json.dumps(SCHEDULE_SCRIPT[int(re.search(r"Turn (\d+) of", text).group(1))])
@@ -411,7 +424,7 @@ def test_early_questions_and_every_unconfirmed_stop_end_to_end(episodes):
                                                                                      (4, [ASK, 0, 4, 1, 1])]
     planner_steps = {c["step"] for c in calls if c["role"] == "planner"}
     assert planner_steps == {0, 2, 3, 5, 6, 7}  # the schedule's questions need no model call
-    assert acts[5] == [ASK, 0, 4, 1, 4] and acts[7] == [ASK, 0, 4, 1, 4]  # each unconfirmed stop confirmed
+    assert acts[5] == [ASK, 0, *CANDIDATE, 4] and acts[7] == [ASK, 0, *CANDIDATE, 4]  # each unconfirmed stop confirmed
     assert acts[6][:4] == [MOVE, 6, 4, 2]  # the stop right after the "no": corrected, then a move (to the right)
     step6 = [c for c in calls if c["step"] == 6 and c["role"] == "planner"][0]
     assert [r["error"] for r in step6["retries"]] == [CORRECTIONS["stop_after_no"]]
