@@ -63,6 +63,7 @@ import math
 from dataclasses import dataclass, field
 
 from ignjax.agents.llm.agent import ASK, MOVE, NO_QUESTIONS_LEFT, QUESTION_HELP, QUESTION_NAMES, STOP, Decision
+from ignjax.agents.llm.graph_memory import PlaceGraph
 from ignjax.scenes import vocab
 from ignjax.sim import types as T
 from ignjax.sim.views.compose import view_names
@@ -118,6 +119,7 @@ class TandemMemory:
     unexplored: list = field(default_factory=list)
     observations: list = field(default_factory=list)
     places: list = field(default_factory=list)  # map-like memory (mapgpt): "step k: place"
+    graph: PlaceGraph = field(default_factory=PlaceGraph)  # graph memory (gta): places from the agent's odometry
     moves: list = field(default_factory=list)  # (step, direction name, subgoal, rear-family, outcome)
     history: list = field(default_factory=list)  # (step, kind, action, reason): LLMAgent's record
     positions: list = field(default_factory=list)  # odometry (x, y) per decision

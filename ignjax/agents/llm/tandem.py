@@ -50,7 +50,9 @@ output contract; runtime state). Everything numeric the controller reads
 :attr:`~ignjax.agents.llm.agent.Decision.percept` and never reaches the
 model as a number; where the agent is by room, the controller takes from
 the Planner's own belief updates, and the goal room from the oracle's
-Type-2 answer.
+Type-2 answer. The numbers the model does see are its own: the front
+view's heading, its offset from the start (:attr:`Decision.offset`) and,
+with ``memory_style="graph"``, the place graph built from that offset.
 
 Variants (:data:`TANDEM_AGENTS`, README "MLLM agents"): ``tandem``;
 ``tandem-no-spmem`` (no Spatial Memory: belief updates dropped, the memory
@@ -62,7 +64,9 @@ degrees or 12 narrow views of 30, each set tiling the circle;
 :func:`ignjax.protocol.view_hfov`).
 Baselines in the style of the paper's adaptations (our reading of each, on
 this machinery; the paper's own code is not used): ``gta``
-(Planner-Grounder without Spatial Memory), ``coin`` (no route questions),
+(Planner-Grounder; instead of Spatial Memory a topological graph of places
+from the agent's own odometry, with visit counts and a loop alert, and a
+Planner that weighs directions before choosing), ``coin`` (no route questions),
 ``mapgpt`` (one stage: the Planner picks the grid cell itself, with a
 map-like text memory of places and their links), ``navgpt`` (one stage,
 text only: each view described from the simulator's perception, stated as
@@ -76,6 +80,9 @@ from ignjax.agents.llm.agent import (ASK, MOVE, MOVED_M, QUESTION_HELP, QUESTION
                                      orientation_text)
 from ignjax.agents.llm.client import ChatRequest
 from ignjax.agents.llm.controller import RECOVERY_MOVES, TEXT_CHARS, TandemController, TandemMemory, clip, rear
+from ignjax.agents.llm.counterfactual import PROMPT as COUNTERFACTUAL_PROMPT
+from ignjax.agents.llm.counterfactual import counterfactual_error, with_counterfactuals
+from ignjax.agents.llm.graph_memory import MERGE_M, graph_text
 from ignjax.sim import types as T
 from ignjax.sim.views.compose import view_names
 
@@ -164,8 +171,13 @@ class Tandem(TandemController, LLMAgent):
             every decision the model's).
         two_stage: a Grounder picks the cell (False: the Planner picks it).
         route_questions: Type 3 may be asked (False: COIN-style).
-        memory_style: ``"spatial"`` (the paper's fields) or ``"map"``
-            (MapGPT-style: places visited and how they connect).
+        memory_style: ``"spatial"`` (the paper's fields), ``"map"``
+            (MapGPT-style: places visited and how they connect) or
+            ``"graph"`` (GTA-style: a topological graph of places from the
+            agent's own odometry, with visit counts and a loop alert;
+            :mod:`ignjax.agents.llm.graph_memory`).
+        counterfactual: the Planner's reply weighs directions before choosing
+            (GTA-style; :mod:`ignjax.agents.llm.counterfactual`).
         observation: ``"panel"`` or ``"text"`` (NavGPT-style captions from
             the simulator's perception).
         n_views: views of the panel (4, 8 or 12; the observation ablation).
@@ -178,16 +190,18 @@ class Tandem(TandemController, LLMAgent):
 
     def __init__(self, spatial_memory: bool = True, qa: bool = True, cost_aware: bool = True, safeguards: bool = True,
                  two_stage: bool = True, route_questions: bool = True, memory_style: str = "spatial",
-                 observation: str = "panel", n_views: int | None = None, reasks: int = 2):
+                 counterfactual: bool = False, observation: str = "panel", n_views: int | None = None,
+                 reasks: int = 2):
         if observation not in ("panel", "text"):
             raise ValueError(f"observation must be 'panel' or 'text', got {observation!r}")
-        if memory_style not in ("spatial", "map"):
-            raise ValueError(f"memory_style must be 'spatial' or 'map', got {memory_style!r}")
+        if memory_style not in ("spatial", "map", "graph"):
+            raise ValueError(f"memory_style must be 'spatial', 'map' or 'graph', got {memory_style!r}")
         if n_views not in (None, 4, 8, 12):
             raise ValueError(f"n_views must be 4, 8 or 12, got {n_views!r}")
         self.spatial_memory, self.qa, self.show_costs = bool(spatial_memory), bool(qa), bool(cost_aware)
         self.safeguards, self.two_stage, self.route_questions = bool(safeguards), bool(two_stage), bool(route_questions)
         self.memory_style, self.observation, self.n_views, self.reasks = memory_style, observation, n_views, int(reasks)
+        self.counterfactual = bool(counterfactual)
         self.may_ask = self.qa
         self.uses_views = self.two_stage and observation == "panel"
 
@@ -229,10 +243,7 @@ class Tandem(TandemController, LLMAgent):
         if self.qa:
             blocks.append(
                 # block 2: memory and interaction
-                ("You keep a memory of the search (given back to you each turn) and update it in 'belief_update': "
-                 "the room you think you are in, what you know about the target, areas you have visited and what "
-                 "was there, openings you have not explored yet, and anything else worth remembering.\n"
-                 if self.spatial_memory else "")
+                self.memory_intro(detail=True)
                 + "You may ask a helper who knows the house. Question types:\n"
                 + "\n".join(f"  {t} ({QUESTION_NAMES[t]}): {QUESTION_HELP[t]}{costs(t)}" for t in qtypes)
                 + "\nEvery question lowers the final score" + (" by its cost" if self.show_costs else "")
@@ -241,8 +252,7 @@ class Tandem(TandemController, LLMAgent):
             blocks.append(self.policies_text())  # block 3: question, hint and recovery policies
         else:
             blocks.append(
-                ("You keep a memory of the search (given back to you each turn) and update it in 'belief_update'.\n"
-                 if self.spatial_memory else "")
+                self.memory_intro(detail=False)
                 + "You cannot ask questions: the target's description is given in the Fact Base. Stop when you are "
                 "next to the target. Avoid going back and forth.")
         cell = (" and 'col', 'row': the cell of the grid on that view to walk toward (columns 1-8 left to right, "
@@ -251,15 +261,35 @@ class Tandem(TandemController, LLMAgent):
                 "about" if not self.two_stage else
                 "; for a confirmation question (type 4), 'subgoal' names the object you ask about, which must be in "
                 "your front view (a stop without confirmation becomes such a question about your subgoal)")
+        weigh = ("'counterfactuals' (the directions you weighed, each with 'direction' and 'expected'), "
+                 if self.counterfactual else "")
+        if self.counterfactual:
+            blocks.append(COUNTERFACTUAL_PROMPT)  # GTA-style: weigh alternatives before choosing
         blocks.append(
             # block 4: output contract
             "Reply with one JSON object and nothing else, with every key present: 'reasoning' (short), 'task_phase' "
             f"({' | '.join(PHASES)}), 'belief_update' (current_room, target_description, visited_areas, "
-            "unexplored_areas, key_observations), 'action' (move | ask | stop), 'direction' (one of "
+            f"unexplored_areas, key_observations), {weigh}'action' (move | ask | stop), 'direction' (one of "
             f"{', '.join(names)}), 'subgoal' (the place to reach in that view, e.g. 'the centre of the open doorway', "
             "not an action like 'explore'), 'purpose' (why), 'question_type' (1-4) and 'question' (the question's "
             f"text){cell}. Keys your action does not use are ignored.")
         return "\n\n".join(blocks)
+
+    def memory_intro(self, detail: bool) -> str:
+        """The system prompt's sentence on the agent's memory ("" without one)."""
+        if not self.spatial_memory:
+            return ""
+        if self.memory_style == "graph":
+            return ("Each turn you also get a graph of the places you have been, built from your own odometry: each "
+                    "place with its position in metres from your start, how many times you have entered it and which "
+                    f"places it links to (positions within {MERGE_M:g} m count as one place). Use it to keep track of "
+                    "where you have been; when it shows a loop alert, re-plan and head for a place you have not "
+                    "been.\n")
+        if not detail:
+            return "You keep a memory of the search (given back to you each turn) and update it in 'belief_update'.\n"
+        return ("You keep a memory of the search (given back to you each turn) and update it in 'belief_update': "
+                "the room you think you are in, what you know about the target, areas you have visited and what "
+                "was there, openings you have not explored yet, and anything else worth remembering.\n")
 
     def policies_text(self) -> str:
         """Block 3 of the Planner's system prompt: question, hint, stop and recovery policies."""
@@ -282,6 +312,8 @@ class Tandem(TandemController, LLMAgent):
             "backward move prefer a new front or side way.")
 
     def memory_text(self, m: TandemMemory) -> str:
+        if self.memory_style == "graph":
+            return graph_text(m.graph)
         if self.memory_style == "map":
             return ("Places so far (in order; each reached from the one before):\n"
                     + ("\n".join(f"- {p}" for p in m.places[-MEMORY_ITEMS * 2:]) or "- (start)"))
@@ -312,7 +344,8 @@ class Tandem(TandemController, LLMAgent):
         if p.get("confirm") == 1 and p.get("follow_up") == T.FOLLOW_ONE_MOVE:
             parts.append("Follow-up: the target is confirmed; make one closer move, then stop.")
         if self.spatial_memory:
-            parts.append("Spatial Memory:\n" + self.memory_text(m))
+            parts.append(self.memory_text(m) if self.memory_style == "graph" else
+                         "Spatial Memory:\n" + self.memory_text(m))
             if m.last_purpose:
                 parts.append(f"Last purpose: {m.last_purpose}")
         hist = [f"step {s}: {n}" + (f" toward {g}" if g else "") + (f" ({o})" if o else "") for s, n, g, _, o in m.moves[-6:]]
@@ -334,6 +367,8 @@ class Tandem(TandemController, LLMAgent):
         actions = ("move", "ask", "stop") if self.may_ask else ("move", "stop")
         questions = (1, 2, 3, 4) if self.route_questions else (1, 2, 4)
         schema = (planner_schema if self.two_stage else one_stage_schema)(names, actions, questions)
+        if self.counterfactual:
+            schema = with_counterfactuals(schema, names)
         return ChatRequest(messages=[{"role": "system", "content": self.planner_system(d)},
                                      {"role": "user", "content": content}],
                            schema=schema, schema_name="planner_decision", tag=d.episode)
@@ -366,6 +401,8 @@ class Tandem(TandemController, LLMAgent):
         b = parsed.get("belief_update")
         if isinstance(b, dict) and clip(b.get("current_room"), 80):
             m.room_claim = clip(b.get("current_room"), 80)  # the controller's reading of where the agent thinks it is
+        if self.memory_style == "graph":
+            return  # the graph is built from odometry (_observe_outcome), not from the model's words
         if self.memory_style == "map":
             b = parsed.get("belief_update") or {}
             place = clip(b.get("current_room") if isinstance(b, dict) else "", 80)
@@ -400,6 +437,8 @@ class Tandem(TandemController, LLMAgent):
         if m.questions and m.questions[-1][1] == 4 and m.questions[-1][0] == d.step - 1:
             m.candidates.append(f"step {d.step - 1}: " + ("confirmed" if p.get("confirm") == 1 else "rejected"))
         m.positions.append(tuple(p.get("odometry", (0.0, 0.0))))
+        if self.memory_style == "graph":
+            m.graph.visit(d.offset)  # the agent's own offset from its start, as shown in the runtime block
 
     # -- one decision ------------------------------------------------------
     async def decide(self, ctx, m: TandemMemory, d: Decision):
@@ -434,6 +473,10 @@ class Tandem(TandemController, LLMAgent):
     def _parse_plan(self, m: TandemMemory, d: Decision, parsed, err):
         if parsed is None:
             return None, err or "the reply is not a JSON object"
+        if self.counterfactual:
+            why = counterfactual_error(parsed, view_names(d.n_views))
+            if why is not None:
+                return None, why
         act, why = self._check(m, d, parsed)
         if act is None:
             return None, why
@@ -503,9 +546,10 @@ TANDEM_AGENTS = {
                              cost_aware=False, safeguards=False),
     "tandem-4v": _variant("tandem-4v", "TANDEM with 4 views (observation ablation)", n_views=4),
     "tandem-12v": _variant("tandem-12v", "TANDEM with 12 views (observation ablation)", n_views=12),
-    "gta": _variant("gta", "GTA-style: Planner + Grounder without Spatial Memory, cost-aware", spatial_memory=False),
-    "gta-naive": _variant("gta-naive", "GTA-style, naive-QA", spatial_memory=False, cost_aware=False,
-                          safeguards=False),
+    "gta": _variant("gta", "GTA-style: Planner + Grounder, a place graph from odometry with a loop alert, "
+                           "counterfactual reasoning, cost-aware", memory_style="graph", counterfactual=True),
+    "gta-naive": _variant("gta-naive", "GTA-style, naive-QA", memory_style="graph", counterfactual=True,
+                          cost_aware=False, safeguards=False),
     "coin": _variant("coin", "COIN-style: no route questions, cost-aware", route_questions=False),
     "coin-naive": _variant("coin-naive", "COIN-style, naive-QA", route_questions=False, cost_aware=False,
                            safeguards=False),

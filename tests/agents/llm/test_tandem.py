@@ -436,7 +436,7 @@ def test_early_questions_and_every_unconfirmed_stop_end_to_end(episodes):
 
 
 @render_ok
-@pytest.mark.parametrize("name", ["tandem", "tandem-no-qa", "navgpt", "mapgpt", "tandem-4v", "tandem-12v"])
+@pytest.mark.parametrize("name", ["tandem", "tandem-no-qa", "navgpt", "mapgpt", "gta", "tandem-4v", "tandem-12v"])
 def test_baselines_send_what_they_should(episodes, name):
     """Schema-valid random replies from the scripted server: every episode
     finishes and each agent's requests carry its inputs."""
@@ -461,6 +461,9 @@ def test_baselines_send_what_they_should(episodes, name):
     if name in ("navgpt", "mapgpt"):
         assert len(planner) == len(seen)  # one stage: no Grounder
         assert "col" in planner[0]["response_format"]["json_schema"]["schema"]["properties"]
+    if name == "gta":  # the place graph in every Planner request, the counterfactual field in its schema
+        assert all("Place graph" in _texts(r) for r in planner)
+        assert "counterfactuals" in planner[0]["response_format"]["json_schema"]["schema"]["required"]
     if name == "tandem-no-qa":
         enum = planner[0]["response_format"]["json_schema"]["schema"]["properties"]["action"]["enum"]
         assert "ask" not in enum and "cannot ask" in system
