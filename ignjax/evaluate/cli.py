@@ -131,6 +131,9 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--llm-paraphrase", action="store_true",
                    help="have the model reword each oracle answer before the agent reads it (a rewording that breaks "
                         "the answer's rules is dropped for the template); same as --set llm.paraphrase=true")
+    g.add_argument("--llm-naive-unbudgeted", action="store_true",
+                   help="the -naive agents run with no question budget (the reading of the paper's naive rows, "
+                        "README 'Reading the paper's tables'); same as --set llm.naive_unbudgeted=true")
     g.add_argument("--llm-concurrency", type=int, default=None, help="requests in flight per endpoint (default 16)")
     g.add_argument("--llm-batch", type=int, default=64, help="episodes in flight at once (default 64; keep it at least twice "
                    "llm.concurrency x endpoints so every server slot has a request queued)")
@@ -199,6 +202,8 @@ def llm_settings(args, sections: dict, out_dir: Path):
         d["concurrency"] = args.llm_concurrency
     if args.llm_paraphrase:
         d["paraphrase"] = True
+    if args.llm_naive_unbudgeted:
+        d["naive_unbudgeted"] = True
     if args.llm_replay:
         d["replay"] = True
     d.setdefault("cache_dir", str(args.llm_cache or out_dir / "llm_cache"))

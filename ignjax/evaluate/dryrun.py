@@ -32,7 +32,9 @@ def dry_run(agent: LLMAgent, n_episodes: int, *, sim: T.SimConfig = T.SimConfig(
     first decision of an episode with no answers yet."""
     from ignjax.sim.views.compose import panel_layout
 
-    sim = dataclasses.replace(sim, **dict(getattr(agent, "sim_overrides", {}) or {}))
+    from ignjax.agents.llm.catalog import sim_overrides
+
+    sim = dataclasses.replace(sim, **sim_overrides(agent, llm))
     two_stage = bool(getattr(agent, "two_stage", False)) and agent.observation == "panel"
     img = ImagePart(b"\xff\xd8\xff\xd9") if agent.observation == "panel" else None
     d = Decision(episode="dry-run", step=0, max_steps=sim.max_steps, goal="object", questions_left=sim.max_questions,
@@ -64,7 +66,8 @@ def dry_run(agent: LLMAgent, n_episodes: int, *, sim: T.SimConfig = T.SimConfig(
         out["prompt_tokens_per_grounder_request"] = grounder_tokens
     paraphrase_tokens = 0
     if llm is not None and llm.paraphrase and agent.may_ask:  # one per answer; a question per decision at most
-        out["paraphrase_requests"] = n_episodes * min(sim.max_questions, sim.max_steps)
+        out["paraphrase_requests"] = n_episodes * (min(sim.max_questions, sim.max_steps) if sim.question_budget
+                                                   else sim.max_steps)
         route = OT.route_text(0, 2, -1, False, ())
         paraphrase_tokens = text_tokens(ChatRequest(messages=OT.paraphrase_messages(3, route),
                                                     schema=OT.PARAPHRASE_SCHEMA))

@@ -744,7 +744,9 @@ def run_llm_agent(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, *, sim: T.Sim
     """
     if batch < 1:
         raise ConfigError(None, "batch", f"must be >= 1, got {batch}")
-    overrides = dict(getattr(agent, "sim_overrides", {}) or {})
+    from ignjax.agents.llm.catalog import sim_overrides
+
+    overrides = sim_overrides(agent, llm)
     if overrides:  # e.g. the observation ablation's view count, the no-QA variant's upfront description
         sim = dataclasses.replace(sim, **overrides)
     loop = HostLoop(es, agent, llm, sim=sim, views=views, batch=batch, seed=seed, costs=costs,

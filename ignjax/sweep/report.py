@@ -390,6 +390,11 @@ def _section_eval(results: dict, es, rollouts: dict, cfg, out: Path) -> list[str
                       "transcript role `paraphrase`); rewordings refused by the leak checks, the template shown "
                       "instead: " + ", ".join(f"{name} {t['paraphrase_rejected']}"
                                              for name, t in ev["model_totals"].items()) + ".", ""]
+        naive = [n for n in ev["model_totals"] if n.endswith("-naive")]
+        if cfg.llm.naive_unbudgeted and naive:
+            parts += [f"The naive-QA rows ({', '.join(naive)}) ran with no question budget (`llm.naive_unbudgeted`: "
+                      "the reading of the paper's naive rows, README \"Reading the paper's tables\"); every other "
+                      "agent kept the budget.", ""]
     return parts
 
 

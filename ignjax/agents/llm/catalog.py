@@ -18,4 +18,14 @@ def get_llm_agent(name: str, **options) -> LLMAgent:
     return LLM_AGENTS[name](**options)
 
 
-__all__ = ["LLM_AGENTS", "get_llm_agent"]
+def sim_overrides(agent: LLMAgent, llm=None) -> dict:
+    """The simulator settings ``agent`` runs under: its own (``agent.sim_overrides``: the observation ablation's
+    view count, the no-QA variants' upfront description) and, with ``llm.naive_unbudgeted``, no question budget
+    for a naive-QA row (name ending in ``-naive``)."""
+    out = dict(getattr(agent, "sim_overrides", {}) or {})
+    if llm is not None and llm.naive_unbudgeted and agent.name.endswith("-naive"):
+        out["question_budget"] = False
+    return out
+
+
+__all__ = ["LLM_AGENTS", "get_llm_agent", "sim_overrides"]

@@ -86,6 +86,11 @@ class LLMConfig:
             (:func:`ignjax.sim.oracle_text.paraphrase_leaks`) is dropped for
             the template and counted in ``paraphrase_rejected``. Changes
             results, so it is part of a run's fingerprint.
+        naive_unbudgeted: the naive-QA rows (agents whose name ends in
+            ``-naive``) run with no question budget, the reading of the
+            paper's naive rows whose |Q| exceeds the budget (README "Reading
+            the paper's tables"); every other agent keeps the budget.
+            Changes results, so it is part of a run's fingerprint.
         prices: USD per 1M tokens, ``{"prompt": x, "completion": y}``.
         extra_body: extra keys merged into each request's JSON (for example
             vLLM's ``guided_decoding_backend``); may not set the keys the
@@ -111,6 +116,7 @@ class LLMConfig:
     cache_dir: str | None = None
     replay: bool = False
     paraphrase: bool = False
+    naive_unbudgeted: bool = False
     prices: dict | None = None
     extra_body: dict | None = None
 
@@ -219,7 +225,7 @@ def _validate(obj: LLMConfig, where: str, path: str | None) -> None:
                   f"http://127.0.0.1:8000/v1, got {e!r}")
     if len(set(eps)) != len(eps):
         _fail(path, where, "endpoints", "lists the same URL twice")
-    for name in ("replay", "paraphrase"):
+    for name in ("replay", "paraphrase", "naive_unbudgeted"):
         if not isinstance(getattr(obj, name), bool):
             _fail(path, where, name, f"expected true or false, got {getattr(obj, name)!r}")
     object.__setattr__(obj, "endpoints", eps)
