@@ -15,6 +15,10 @@ follow the paper's rules:
   (:func:`route_leaks` checks this).
 * Type 4 (confirmation) says yes or no with a short reason and, after a
   yes, whether to stop now or take one closer move first.
+* After each step with an active route hint, the controller's report
+  (:func:`hint_report_text`) says whether the agent got closer and on which
+  side the hinted area lies now, relative to its current facing (the same
+  egocentric words, no digit or compass word).
 
 Optionally (``llm.paraphrase``), a model rewords each answer before the
 agent reads it (:func:`paraphrase_messages`, :data:`PARAPHRASE_SCHEMA`;

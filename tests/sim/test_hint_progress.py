@@ -253,8 +253,9 @@ def test_bearing_turns_from_ahead_to_the_side_when_the_agent_turns_left(sim):
     cfg = sim["world"].config
     starts = np.asarray(sim["es"].specs.start)
     is_left = np.array([d == 2 for d, _, _ in MOVES])
+    far = cfg.hint_lookahead + cfg.stop_radius + 2.0
     for k in range(len(sim["es"])):
-        if _geodesic(sim["world"], _spec(sim["es"], k), starts[k:k + 1, :2])[0] < cfg.hint_lookahead + cfg.stop_radius + 2.0:
+        if _geodesic(sim["world"], _spec(sim["es"], k), starts[k:k + 1, :2])[0] < far:
             continue
         st, hint, start = _facing_the_hint(sim, k)
         assert int(st.answers.hint_bearing) == 0

@@ -286,7 +286,8 @@ class Tandem(TandemController, LLMAgent):
                "were), a long corridor, or a known goal room whose way in is unclear. While a route hint is "
                "active, use it as your main bias and choose short, reachable places on the hinted side (after each "
                "move you are told where the hinted area lies now, relative to your new facing: follow that side, "
-               "not the words first spoken); trust what you see if it contradicts the hint.\n" if self.route_questions else "")
+               "not the words first spoken); trust what you see if it contradicts the hint.\n"
+               if self.route_questions else "")
             + "- Ask for a confirmation when an object in front of you might be the target. After a yes with "
             "'move closer', make exactly one move toward it and then stop; after a plain yes, stop.\n"
             "- Stop only when the target is confirmed or a hint says you are close enough to it"
