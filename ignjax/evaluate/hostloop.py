@@ -40,6 +40,14 @@ it as ``question`` ("" when the agent's controller asked without one), and
 :func:`ignjax.evaluate.accounting.question_texts` collects them (the Type-3 content analysis reads
 them). The oracle answers by type either way.
 
+Route hint: after every step of a row with an active Type-3 hint, the loop
+words the controller's report on it (:func:`ignjax.sim.oracle_text.hint_report_text`
+of ``Answer.hint_progress`` and ``Answer.hint_bearing``: closer / farther /
+reached, and the side the hinted area lies on now, recomputed by the
+simulator from the new pose and heading); the next decision carries it as
+:attr:`~ignjax.agents.llm.agent.Decision.hint_report`, next to the
+executor's report on the move itself (``last_move``).
+
 Paraphrase (``llm.paraphrase``): before a decision, each oracle answer the
 agent has not read yet (refusals excepted) is sent through the same client
 (:func:`ignjax.sim.oracle_text.paraphrase_messages`; one request per answer,
@@ -111,7 +119,7 @@ class _Episode:
     calls: list = field(default_factory=list)
     acc: dict = field(default_factory=A.new_accounting)
     failure: str = ""
-    progress: str = ""
+    progress: str = ""  # the active route hint's report after the last step (Decision.hint_report)
     images: list = field(default_factory=list)
     unread: list = field(default_factory=list)  # indices into answers still to paraphrase (llm.paraphrase)
     front: tuple | None = None  # what the pending decision showed of its front view, to resolve a Type-4 cell
@@ -347,7 +355,8 @@ class HostLoop:
                        "room": int(obs["room_label"][r]), "known": ans.known[r].tolist(),
                        "goal_room": int(ans.room_label[r]) if ans.known[r][1] else -1, "confirm": int(ans.confirm[r]),
                        "follow_up": int(ans.follow_up[r]), "hint_active": bool(ans.hint_active[r]),
-                       "hint_progress": int(ans.hint_progress[r]), "blocked": obs["blocked"][r].tolist(),
+                       "hint_progress": int(ans.hint_progress[r]), "hint_bearing": int(ans.hint_bearing[r]),
+                       "blocked": obs["blocked"][r].tolist(),
                        "moved": float(obs["last_move"][r])}
             rec = self.es.records[ep.index]
             text = front = None
@@ -361,7 +370,7 @@ class HostLoop:
                 episode=rec["episode_id"], step=int(step[r]), max_steps=self.sim.max_steps,
                 goal=vocab.category_display(rec["target_category"]), questions_left=int(qleft[r]),
                 costs=self.costs, answers=tuple(ep.answers),
-                last_move=" ".join(t for t in (_last_move_text(obs, r, last_kind), ep.progress) if t),
+                last_move=_last_move_text(obs, r, last_kind), hint_report=ep.progress,
                 n_views=self.sim.n_views, view_fov=self.sim.view_hfov, observation=text, percept=percept,
                 heading=compass_degrees(pose[r][2]), offset=tuple(float(v) for v in obs["odometry"][r][:2]))})
         return out
@@ -600,9 +609,8 @@ class HostLoop:
                         if acts[r, 0] == ASK:
                             self._answer(ep, int(acts[r, 4]), answers, r, int(before_step[r]),
                                          pointed=int(cand[r]) != T.NO_CANDIDATE)
-                        elif acts[r, 0] == MOVE:
-                            ep.progress = OT.hint_progress_text(int(answers.hint_progress[r])) \
-                                if answers.hint_active[r] else ""
+                        ep.progress = OT.hint_report_text(int(answers.hint_progress[r]), int(answers.hint_bearing[r])) \
+                            if answers.hint_active[r] else ""
                     ended = [r for r in np.flatnonzero((step_mask | fail_mask) & done_now)]
                     if ended:
                         outs = await loop.run_in_executor(None, lambda st=states: jax.tree.map(np.asarray, self._outcome(st)))

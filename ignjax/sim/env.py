@@ -47,8 +47,10 @@ Protocol (paper §3.3, Appendix C; constants in :class:`~ignjax.sim.types.SimCon
   for ``hint_lookahead`` metres from the agent and reports the room it
   leads toward, the egocentric sector of the way out (or of the route's
   end when it stays in the room) and a landmark near its end; it also
-  activates a persistent hint whose qualitative progress is updated after
-  every MOVE. Type 4 says yes only if the target (or the queried
+  activates a persistent hint whose qualitative progress (closer, farther,
+  reached, stop-eligible) and current bearing (the sector, relative to the
+  agent's new facing, in which the hinted point lies) are updated after
+  every MOVE; the bearing is first set when the hint is given. Type 4 says yes only if the target (or the queried
   candidate, which must then be the target) is visible in the current
   front view within ``confirm_range`` metres; a yes starts the follow-up
   (stop now within ``stop_radius``, else one closer move then stop: the
@@ -76,7 +78,7 @@ from ignjax.sim import types as T
 from ignjax.sim.compact import masked_map
 from ignjax.sim.executor import execute_moves, pixel_waypoint
 from ignjax.sim.observation import observe, observe_all, observe_batch
-from ignjax.sim.oracle import ask, describe_upfront, hint_progress
+from ignjax.sim.oracle import ask, describe_upfront, hint_bearing, hint_progress
 from ignjax.sim.queries import euclidean_to_target, geodesic_to_target
 from ignjax.sim.world import World
 
@@ -152,12 +154,13 @@ def step_batch(world: World, states: T.SimState, actions: T.Action, chunk: int |
         a = states.answers
         progress = jax.vmap(lambda e, ans, hp, p0, p1: hint_progress(world, e, ans, hp, p0, p1))(
             states.episode, a, states.hint_point, states.pose[:, :2], pose[:, :2])
+        bearing = jax.vmap(hint_bearing)(states.hint_point, pose, a.hint_active)
         # the Type-4 follow-up: after the one closer move, "stop now"
         follow = jnp.where(a.follow_up == T.FOLLOW_ONE_MOVE, T.FOLLOW_STOP_NOW, a.follow_up).astype(jnp.int32)
         moved_state = dataclasses.replace(
             states, pose=pose, path_length=states.path_length + moved, min_distance=dmin, blocked=blocked,
             last_move=moved, waypoint=wp, moves_since_confirm=states.moves_since_confirm + 1,
-            answers=dataclasses.replace(a, hint_progress=progress, follow_up=follow),
+            answers=dataclasses.replace(a, hint_progress=progress, hint_bearing=bearing, follow_up=follow),
         )
         # ASK
         asked_state = ask_rows(world, states, act, is_ask, chunk)

@@ -1,6 +1,7 @@
 """The oracle as array facts: what each question type answers (the ASK
 rules of :mod:`ignjax.sim.env`'s docstring), the charging of questions
-against the budget, and the progress of an active route hint after a MOVE.
+against the budget, and the progress and current bearing of an active
+route hint after a MOVE.
 
 Answers are :class:`~ignjax.sim.types.Answer` arrays; their words are
 rendered on the host by :mod:`ignjax.sim.oracle_text`.
@@ -149,6 +150,7 @@ def ask(world: World, state: T.SimState, qtype, candidate) -> T.SimState:
         hint_landmark=jnp.where(is3, land3, a.hint_landmark), hint_in_room=jnp.where(is3, inroom3, a.hint_in_room),
         hint_active=a.hint_active | is3,
         hint_progress=jnp.where(is3, T.HINT_NONE, a.hint_progress),
+        hint_bearing=jnp.where(is3, hint_bearing(point3, state.pose, jnp.array(True)), a.hint_bearing),
         confirm=jnp.where(is4, yes.astype(jnp.int32), a.confirm),
         follow_up=jnp.where(is4, follow, a.follow_up),
     )
@@ -171,3 +173,14 @@ def hint_progress(world: World, ep, a: T.Answer, hint_point, old_xy, new_xy):
     prog = jnp.where(d_new <= cfg.hint_reached, T.HINT_REACHED, prog)
     prog = jnp.where(geodesic_to_target(world, ep, new_xy) <= cfg.stop_radius, T.HINT_STOP, prog)
     return jnp.where(a.hint_active, prog, T.HINT_NONE).astype(jnp.int32)
+
+
+def hint_bearing(hint_point, pose, active):
+    """() int32 egocentric sector 0..7 (view layout: 0 ahead, 2 left, 4
+    behind, 6 right; :func:`~ignjax.sim.queries.sector_of`) of the internal
+    ``hint_point`` seen from ``pose`` (x, y, yaw), -1 when ``active`` is
+    false: the relative bearing of the paper's controller (Appendix, Eq.
+    relative-target), which keeps the hinted way's side current after a
+    turn or a detour. Only the sector reaches the agent, never the angle."""
+    rel = jnp.arctan2(hint_point[1] - pose[1], hint_point[0] - pose[0]) - pose[2]
+    return jnp.where(active, sector_of(rel), -1).astype(jnp.int32)

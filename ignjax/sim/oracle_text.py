@@ -15,6 +15,10 @@ follow the paper's rules:
   (:func:`route_leaks` checks this).
 * Type 4 (confirmation) says yes or no with a short reason and, after a
   yes, whether to stop now or take one closer move first.
+* After each step with an active route hint, the controller's report
+  (:func:`hint_report_text`) says whether the agent got closer and on which
+  side the hinted area lies now, relative to its current facing (the same
+  egocentric words, no digit or compass word).
 
 Optionally (``llm.paraphrase``), a model rewords each answer before the
 agent reads it (:func:`paraphrase_messages`, :data:`PARAPHRASE_SCHEMA`;
@@ -140,6 +144,37 @@ def answer_text(question: int, refused: bool, *, appearance: str, region: str, h
 def hint_progress_text(progress: int) -> str:
     """Qualitative progress report of an active Type-3 hint after a step."""
     return HINT_PROGRESS_TEXT.get(int(progress), "")
+
+
+def hint_bearing_phrase(progress: int, bearing: int) -> str:
+    """Where the active hint's area lies now, relative to the agent's current
+    facing (:attr:`~ignjax.sim.types.Answer.hint_bearing`, sector 0..7): a
+    :data:`SECTOR_PHRASES` entry. "" without a bearing (-1: no hint) and once
+    the area is reached or the target is within the stop radius
+    (``progress`` :data:`~ignjax.sim.types.HINT_REACHED` or ``HINT_STOP``):
+    the agent then stands at the hinted area, and its side no longer guides."""
+    b, p = int(bearing), int(progress)
+    if not 0 <= b < len(SECTOR_PHRASES) or p in (T.HINT_REACHED, T.HINT_STOP):
+        return ""
+    return SECTOR_PHRASES[b]
+
+
+def hint_report_text(progress: int, bearing: int) -> str:
+    """What the controller reports about an active Type-3 hint after a step:
+    its progress (:func:`hint_progress_text`) and where the hinted area lies
+    now (:func:`hint_bearing_phrase`), e.g. "You are getting closer to the
+    area the last route hint pointed to; it is now ahead and to your left."
+    The paper's controller recomputes the relative bearing after every move
+    or turn, so the hint's side stays current after a detour. Just after the
+    hint was given (no progress yet) only the direction is said; "" with
+    neither (no hint)."""
+    said = hint_progress_text(progress)
+    way = hint_bearing_phrase(progress, bearing)
+    if not way:
+        return said
+    if not said:
+        return f"The area the last route hint pointed to is {way}."
+    return f"{said[:-1]}; it is now {way}."
 
 
 _DIGIT = re.compile(r"\d")

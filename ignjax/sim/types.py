@@ -13,6 +13,8 @@ Codes
     Stop reasons: 0 running, 1 agent STOP, 2 step budget exhausted.
     Hint progress: 0 no hint, 1 closer, 2 no change, 3 farther,
     4 hinted area reached, 5 stop-eligible (target within the stop radius).
+    Hint bearing: the hinted point's egocentric sector 0..7 from the current
+    pose (view layout: 0 ahead, 2 left, 4 behind, 6 right), -1 no hint.
     Follow-up (after a positive Type-4 answer): 0 none, 1 stop now,
     2 one closer move then stop.
 """
@@ -258,6 +260,13 @@ class Answer:
         hint_in_room: () bool Type-3: the route's first 4 m stay in this room.
         hint_active: () bool, a Type-3 hint is active.
         hint_progress: () int32 progress code (see module docstring).
+        hint_bearing: () int32 egocentric sector 0..7 (view layout, as
+            ``hint_sector``) of the active hint's point from the agent's
+            current pose and heading, recomputed after every step that moves
+            or turns the agent (every MOVE) and set when the hint is given;
+            -1 while no hint is active. Qualitative, like the paper's
+            controller reporting whether the hinted way lies ahead, left or
+            right after a detour (Appendix, Eq. relative-target).
         confirm: () int32 Type-4: 1 yes, 0 no, -1 not asked.
         follow_up: () int32 follow-up state after a yes: 1 stop now, 2 one
             closer move then stop; after that move it becomes 1.
@@ -284,6 +293,7 @@ class Answer:
     hint_in_room: jax.Array
     hint_active: jax.Array
     hint_progress: jax.Array
+    hint_bearing: jax.Array
     confirm: jax.Array
     follow_up: jax.Array
 
@@ -294,7 +304,7 @@ class Answer:
                       material=m1, size=m1, state=m1, on_category=m1, near_categories=jnp.full(3, -1, jnp.int32),
                       room_label=m1, region_category=m1, hint_room_label=m1, hint_sector=m1, hint_landmark=m1,
                       hint_in_room=jnp.array(False), hint_active=jnp.array(False),
-                      hint_progress=jnp.int32(HINT_NONE), confirm=m1, follow_up=jnp.int32(FOLLOW_NONE))
+                      hint_progress=jnp.int32(HINT_NONE), hint_bearing=m1, confirm=m1, follow_up=jnp.int32(FOLLOW_NONE))
 
 
 @pytree_dataclass
@@ -381,6 +391,9 @@ AGENT_FIELDS: dict[str, str] = {
     "Answer.hint_in_room": "Type 3: the route's first stretch stays in this room",
     "Answer.hint_active": "Type 3: a spatial hint is active",
     "Answer.hint_progress": "Type 3: qualitative progress since the last move (closer / farther / reached / stop-eligible)",
+    "Answer.hint_bearing": "Type 3: which way the hinted area lies now relative to the agent's facing (ahead / left / "
+                           "behind / right, 8 sectors), as the paper's controller recomputes it after each move; "
+                           "no angle, compass word or distance",
     "Answer.confirm": "Type 4: yes / no",
     "Answer.follow_up": "Type 4: the follow-up state after a yes (stop now / one closer move then stop)",
 }

@@ -1,5 +1,5 @@
-"""Progress of a Type-3 hint, through ``env.step`` on the procedural houses
-of the test benchmark.
+"""Progress and current bearing of a Type-3 hint, through ``env.step`` on
+the procedural houses of the test benchmark.
 
 After a Type-3 answer, every MOVE reports (``Answer.hint_progress``,
 :data:`ignjax.sim.types.HINT_PROGRESS`): "closer" when it brought the agent
@@ -8,6 +8,13 @@ nearer the hinted point, "farther" when it took it away, "reached" within
 (geodesic) of the target; "none" while no hint is active. The distances
 are recomputed here from the poses, the hinted point kept in the state and
 the target's geodesic field.
+
+The hint's bearing (``Answer.hint_bearing``) is the sector 0..7 (view
+layout: 0 ahead, 2 left, 4 behind, 6 right) in which the hinted point lies
+relative to the agent's pose and heading; it is set when the hint is given
+and recomputed after every MOVE, while the sector first spoken
+(``hint_sector``) stays as it was. It is recomputed here in numpy from the
+poses and the hinted point.
 
 Each state is copied onto 24 rows that take 24 different MOVEs (every view,
 three grid cells), so one compiled batched step answers every candidate.
@@ -106,6 +113,7 @@ def test_no_hint_reports_none(sim):
         assert np.any(np.linalg.norm(np.asarray(after.pose[:, :2]) - np.asarray(state.pose[:2]), axis=1) > 0.3)
         assert np.all(np.asarray(after.answers.hint_progress) == T.HINT_NONE)
         assert not np.any(np.asarray(after.answers.hint_active))
+        assert np.all(np.asarray(after.answers.hint_bearing) == -1)
 
 
 def _far_episode(sim, minimum: float) -> int:
@@ -176,3 +184,89 @@ def test_within_the_stop_radius_is_stop_eligible(sim):
     assert (r["geo"] <= cfg.stop_radius).sum() >= 1
     assert np.all(r["code"][r["geo"] <= cfg.stop_radius] == T.HINT_STOP)
     assert (r["code"] == T.HINT_STOP).sum() >= 1
+
+
+def _sectors(pose, hint) -> tuple[np.ndarray, np.ndarray]:
+    """The hinted point's sector (view layout, 45 degrees each, sector 0
+    centred ahead, counter-clockwise) from poses (N, 3), in float64, and
+    whether each lies clear of a sector edge (0.01 rad)."""
+    pose = np.atleast_2d(np.asarray(pose, np.float64))
+    hint = np.asarray(hint, np.float64)
+    rel = np.arctan2(hint[1] - pose[:, 1], hint[0] - pose[:, 0]) - pose[:, 2]
+    rel = (rel + np.pi) % (2 * np.pi) - np.pi
+    step = rel / (np.pi / 4)
+    clear = np.abs(step - np.floor(step) - 0.5) > 0.01 / (np.pi / 4)
+    return np.round(step).astype(int) % 8, clear
+
+
+def _check_bearings(after, hint) -> np.ndarray:
+    """Every row's bearing against the sector recomputed from its pose; returns them."""
+    want, clear = _sectors(after.pose, hint)
+    code = np.atleast_1d(np.asarray(after.answers.hint_bearing))
+    assert clear.sum() >= len(clear) - 2
+    np.testing.assert_array_equal(code[clear], want[clear])
+    return code
+
+
+def test_bearing_is_set_with_the_hint_and_follows_every_move(sim):
+    """The Type-3 answer sets the bearing from the pose it was asked at; after
+    each of 24 MOVEs it is the hinted point's sector from the new pose and
+    heading, while the sector first spoken is left as it was. The moves
+    face eight ways, so the bearing takes several values."""
+    cfg = sim["world"].config
+    k = _far_episode(sim, cfg.hint_lookahead + cfg.stop_radius + 2.0)
+    st = sim["reset"](sim["world"], _spec(sim["es"], k))
+    assert int(st.answers.hint_bearing) == -1
+    st = _ask(sim, st, 3)
+    hint = np.asarray(st.hint_point)
+    _check_bearings(st, hint)
+    after = _every_move(sim, st)
+    code = _check_bearings(after, hint)
+    assert np.all(np.asarray(after.answers.hint_sector) == int(st.answers.hint_sector))
+    assert len(set(code.tolist())) >= 3
+    # a question after the moves leaves the bearing as the last move set it
+    row = _row(after, 0)
+    asked = _ask(sim, row, 1)
+    assert int(asked.answers.hint_bearing) == int(row.answers.hint_bearing)
+
+
+def _facing_the_hint(sim, k):
+    """Episode k started facing its hinted point, with the hint given:
+    (state, hinted point, start pose)."""
+    world = sim["world"]
+    spec = _spec(sim["es"], k)
+    hint = np.asarray(_ask(sim, sim["reset"](world, spec), 3).hint_point)
+    start = np.asarray(spec.start, np.float64)
+    start[2] = np.arctan2(hint[1] - start[1], hint[0] - start[0])
+    st = _ask(sim, sim["reset"](world, dataclasses.replace(spec, start=jnp.asarray(start, jnp.float32))), 3)
+    np.testing.assert_allclose(np.asarray(st.hint_point), hint)  # the route does not depend on the facing
+    return st, hint, start
+
+
+def test_bearing_turns_from_ahead_to_the_side_when_the_agent_turns_left(sim):
+    """An agent that faces the hinted point hears it straight ahead (sector
+    0); after a MOVE into its left view that leaves it facing about 90
+    degrees further counter-clockwise, the point lies on its right (sector
+    6, or 5 behind-right when the move carried it well sideways), as the
+    pose and the point give it, while the sector first spoken stays.
+    Episodes are tried in order until one has room for such a move."""
+    cfg = sim["world"].config
+    starts = np.asarray(sim["es"].specs.start)
+    is_left = np.array([d == 2 for d, _, _ in MOVES])
+    far = cfg.hint_lookahead + cfg.stop_radius + 2.0
+    for k in range(len(sim["es"])):
+        if _geodesic(sim["world"], _spec(sim["es"], k), starts[k:k + 1, :2])[0] < far:
+            continue
+        st, hint, start = _facing_the_hint(sim, k)
+        assert int(st.answers.hint_bearing) == 0
+        after = _every_move(sim, st)
+        code = _check_bearings(after, hint)
+        pose = np.asarray(after.pose, np.float64)
+        turn = (pose[:, 2] - start[2] - np.pi / 2 + np.pi) % (2 * np.pi) - np.pi
+        left = is_left & (np.linalg.norm(pose[:, :2] - start[:2], axis=1) > 0.3) & (np.abs(turn) < np.radians(10))
+        if left.any():
+            break
+    else:
+        pytest.fail("no episode has a MOVE into the left view that turns the agent about 90 degrees")
+    assert set(code[left].tolist()) <= {5, 6}
+    assert np.all(np.asarray(after.answers.hint_sector)[left] == int(st.answers.hint_sector))

@@ -260,6 +260,30 @@ def test_type3_answers_never_leak_metrics_or_compass(small_benchmark, small_worl
         assert OT.route_leaks(bad), bad
 
 
+def test_hint_reports_say_the_current_side_in_words_only():
+    """The report on an active hint after a step (every progress code with
+    every bearing) names the hinted area's current side with the oracle's
+    sector phrases, passes :func:`~ignjax.sim.oracle_text.route_leaks`, and
+    drops the side once the area is reached or the target is near."""
+    texts = {}
+    for progress in range(len(T.HINT_PROGRESS)):
+        for bearing in range(-1, 8):
+            t = texts[progress, bearing] = OT.hint_report_text(progress, bearing)
+            assert not OT.route_leaks(t), (t, OT.route_leaks(t))
+            said = OT.hint_progress_text(progress)
+            if bearing < 0 or progress in (T.HINT_REACHED, T.HINT_STOP):
+                assert t == said
+            elif progress == T.HINT_NONE:  # just given: only the side
+                assert t == f"The area the last route hint pointed to is {OT.SECTOR_PHRASES[bearing]}."
+            else:
+                assert t.startswith(said[:-1]) and t.endswith(f"it is now {OT.SECTOR_PHRASES[bearing]}.")
+    assert texts[T.HINT_NONE, -1] == ""
+    assert len({texts[T.HINT_CLOSER, b] for b in range(8)}) == 8
+    assert texts[T.HINT_CLOSER, 1] == ("You are getting closer to the area the last route hint pointed to; it is now "
+                                       "ahead and to your left.")
+    assert texts[T.HINT_FARTHER, 4].endswith("; it is now behind you.")
+
+
 def _at_reference_view(small_benchmark, k):
     es = small_benchmark["set"]
     rec = es.records[k]

@@ -115,7 +115,13 @@ class Decision:
         questions_left: questions the agent may still ask.
         costs: the four question types' costs (the cost-aware setting shows them).
         answers: the oracle's answers so far, in order, as ``(type, text)``.
-        last_move: what the executor reported about the last MOVE ("" at the start).
+        last_move: what the executor reported about the last MOVE ("" at the
+            start and after a question).
+        hint_report: the controller's report on the active route hint after
+            the last step: its progress and where the hinted area lies now,
+            relative to the agent's current facing
+            (:func:`ignjax.sim.oracle_text.hint_report_text`); "" while no
+            Type-3 hint is active.
         n_views: views in the panel.
         view_fov: horizontal field of view of each view, degrees (the
             simulator's ``view_hfov``; 0: the default for ``n_views``, 90
@@ -134,6 +140,8 @@ class Decision:
             ``confirm`` the last Type-4 answer (1 yes, 0 no, -1 none),
             ``follow_up`` (1 stop now, 2 one closer move, 0 none),
             ``hint_active``, ``hint_progress`` (:data:`ignjax.sim.types.HINT_*`),
+            ``hint_bearing`` the sector 0..7 (view layout of 8) in which the
+            hinted area lies now, relative to the agent's facing (-1 no hint),
             ``blocked`` (8,) bool sectors blocked in the last move, ``moved``
             metres the last move covered.
         heading: the front view's compass heading, degrees in [0, 360): 0
@@ -161,6 +169,7 @@ class Decision:
     view_fov: float = 0.0
     heading: float = 0.0
     offset: tuple[float, float] = (0.0, 0.0)
+    hint_report: str = ""
 
     def __post_init__(self):
         if not self.view_fov:  # the panel's own width (:func:`ignjax.protocol.view_hfov`)
@@ -326,6 +335,8 @@ class VlmAgent(LLMAgent):
         ]
         if d.last_move:
             parts.append(f"Last move: {d.last_move}")
+        if d.hint_report:
+            parts.append(f"Route hint: {d.hint_report}")
         if self.observation == "text":
             parts.append(f"What you see:\n{d.observation}")
         else:

@@ -12,11 +12,13 @@ One decision of :class:`Tandem`:
    questions left) asks a route question (Type 3).
 2. **Planner** (one request): the instruction, the N-view panel (or, for the
    text-only baseline, each view described from the simulator's perception),
-   the Fact Base (the oracle's answers, by type), the active route hint and
-   its progress, the follow-up state, the Spatial Memory (current place,
-   target facts, visited areas, unexplored openings, route hints, blocked
-   moves, candidate status), recent movement history, the steps and
-   questions left and, in the cost-aware setting, each question's cost. It
+   the Fact Base (the oracle's answers, by type), the active route hint
+   (as first spoken, where the hinted area lies now relative to the agent's
+   facing, and its progress: :func:`hint_block`), the follow-up state, the
+   Spatial Memory (current place, target facts, visited areas, unexplored
+   openings, route hints, blocked moves, candidate status), recent movement
+   history, the steps and questions left and, in the cost-aware setting,
+   each question's cost. It
    replies with one JSON decision (:func:`planner_schema`): ask (type and
    question), move (direction, a place-based subgoal, purpose) or stop
    (with its evidence), plus a belief update that the controller merges into
@@ -83,6 +85,7 @@ from ignjax.agents.llm.controller import RECOVERY_MOVES, TEXT_CHARS, TandemContr
 from ignjax.agents.llm.counterfactual import PROMPT as COUNTERFACTUAL_PROMPT
 from ignjax.agents.llm.counterfactual import counterfactual_error, with_counterfactuals
 from ignjax.agents.llm.graph_memory import MERGE_M, graph_text
+from ignjax.sim import oracle_text as OT
 from ignjax.sim import types as T
 from ignjax.sim.views.compose import view_names
 
@@ -144,6 +147,21 @@ GROUNDER_SCHEMA = {
     "required": ["col", "row", "rationale"],
     "additionalProperties": False,
 }
+
+
+def hint_block(hint: str, progress: int, bearing: int) -> str:
+    """The Planner's "Active route hint" block: the hint as the oracle first
+    spoke it, where the hinted area lies now relative to the agent's current
+    facing (``Decision.percept["hint_bearing"]``, recomputed by the simulator
+    after every move, so "on your left" does not outlive a turn) and the
+    progress since the last move (:mod:`ignjax.sim.oracle_text` words both)."""
+    lines = [f"Active route hint: {hint}"]
+    way = OT.hint_bearing_phrase(progress, bearing)
+    if way:
+        lines.append(f"Where the hinted area lies now: {way}.")
+    if said := OT.hint_progress_text(progress):
+        lines.append(f"Progress: {said}")
+    return "\n".join(lines)
 
 
 def _cell(parsed, err):
@@ -301,8 +319,10 @@ class Tandem(TandemController, LLMAgent):
             "holds them, do not ask them again.\n"
             + ("- A route question fits a junction with several plausible ways, a loop (you are back where you "
                "were), a long corridor, or a known goal room whose way in is unclear. While a route hint is "
-               "active, use it as your main bias and choose short, reachable places on the hinted side; trust "
-               "what you see if it contradicts the hint.\n" if self.route_questions else "")
+               "active, use it as your main bias and choose short, reachable places on the hinted side (after each "
+               "move you are told where the hinted area lies now, relative to your new facing: follow that side, "
+               "not the words first spoken); trust what you see if it contradicts the hint.\n"
+               if self.route_questions else "")
             + "- Ask for a confirmation when an object in front of you might be the target. After a yes with "
             "'move closer', make exactly one move toward it and then stop; after a plain yes, stop.\n"
             "- Stop only when the target is confirmed or a hint says you are close enough to it"
@@ -340,7 +360,7 @@ class Tandem(TandemController, LLMAgent):
             parts.append("Questions asked: " + "; ".join(f"step {s}: type {t}" for s, t, _ in m.questions[-8:]))
         p = d.percept
         if p.get("hint_active") and facts[3]:
-            parts.append(f"Active route hint: {facts[3][-1]}" + (f"\nProgress: {d.last_move}" if d.last_move else ""))
+            parts.append(hint_block(facts[3][-1], p.get("hint_progress", T.HINT_NONE), p.get("hint_bearing", -1)))
         if p.get("confirm") == 1 and p.get("follow_up") == T.FOLLOW_ONE_MOVE:
             parts.append("Follow-up: the target is confirmed; make one closer move, then stop.")
         if self.spatial_memory:
@@ -350,7 +370,7 @@ class Tandem(TandemController, LLMAgent):
                 parts.append(f"Last purpose: {m.last_purpose}")
         hist = [f"step {s}: {n}" + (f" toward {g}" if g else "") + (f" ({o})" if o else "") for s, n, g, _, o in m.moves[-6:]]
         parts.append("Movement history: " + ("; ".join(hist) or "none yet"))
-        if d.last_move and not (p.get("hint_active") and facts[3]):
+        if d.last_move:
             parts.append(f"Last move: {d.last_move}")
         parts.append(orientation_text(d))
         parts.append(f"Turn {d.step + 1} of at most {d.max_steps}; questions left: {d.questions_left if self.qa else 0}.")

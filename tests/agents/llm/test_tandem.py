@@ -15,6 +15,7 @@ import re
 from pathlib import Path
 
 import jax
+import jax.numpy as jnp
 import numpy as np
 import pytest
 
@@ -251,10 +252,27 @@ def test_variants_restrict_what_may_be_asked():
 def test_route_hint_mode_and_follow_up_reach_the_prompt():
     a = get_llm_agent("tandem")
     hint = "Take the way to your left; it leads toward the kitchen."
-    d = _decision(answers=[(3, hint)], hint_active=True, last_move="You are getting closer to the area the last route "
-                                                                      "hint pointed to.")
+    # the hint as first spoken, where the hinted area lies now (the agent has turned: it said left, now right),
+    # the progress, and the executor's report on the move itself
+    d = _decision(answers=[(3, hint)], hint_active=True, hint_progress=T.HINT_CLOSER, hint_bearing=6,
+                  last_move="you moved 1.2 m.")
     text = a.state_text(TandemMemory(), d)
-    assert f"Active route hint: {hint}" in text and "Progress: You are getting closer" in text
+    assert (f"Active route hint: {hint}\nWhere the hinted area lies now: to your right.\n"
+            "Progress: You are getting closer to the area the last route hint pointed to.") in text
+    assert "Last move: you moved 1.2 m." in text
+    fresh = a.state_text(TandemMemory(), _decision(answers=[(3, hint)], hint_active=True, hint_bearing=2))
+    assert "Where the hinted area lies now: to your left." in fresh and "Progress:" not in fresh
+    reached = a.state_text(TandemMemory(), _decision(answers=[(3, hint)], hint_active=True,
+                                                     hint_progress=T.HINT_REACHED, hint_bearing=4))
+    assert "Where the hinted area lies now" not in reached and "Progress: You have reached" in reached
+    for t in (text, fresh, reached):
+        block = t.split("Active route hint: ")[1].split("\n\n")[0]
+        assert not OT.route_leaks(block.replace(hint, "")), block
+    # the single-stage VLM hears the same report as one line, beside the move's own
+    vlm = get_llm_agent("vlm")
+    report = OT.hint_report_text(T.HINT_CLOSER, 6)
+    plain = vlm.state_text(vlm.start("e"), dataclasses.replace(d, hint_report=report))
+    assert f"Last move: you moved 1.2 m.\n\nRoute hint: {report}" in plain and report.endswith("now to your right.")
     assert "Active route hint" not in a.state_text(TandemMemory(), _decision(answers=[(3, hint)]))  # expired hint
     follow = a.state_text(TandemMemory(), _decision(confirm=1, follow_up=T.FOLLOW_ONE_MOVE))
     assert "make one closer move, then stop" in follow
@@ -391,6 +409,53 @@ def test_each_decision_path_end_to_end(episodes, tmp_path):
     saved = sorted(x.name for x in (tmp_path / "images" / "tandem").rglob("*.jpg"))
     moved = [step for step, _, act in acts if act[0] == MOVE]
     assert {f"{step:03d}_grounder.jpg" for step in moved} <= set(saved) and any("panel" in n for n in saved)
+
+
+HINT_SCRIPT = {1: _plan("ask", question_type=3), 2: _plan("move", direction="left"), 3: _plan("move", direction="left"),
+               4: _plan("move", direction="front"), 5: _plan("move", direction="right")}
+"""Planner replies per turn of a one-stage Planner that asks for a route hint, then turns and moves."""
+
+
+def _hint_policy(req: dict) -> str:
+    turn = int(re.search(r"Turn (\d+) of", _texts(req)).group(1))
+    return json.dumps({**HINT_SCRIPT.get(turn, _plan("stop")), "col": 4, "row": 2})
+
+
+def test_route_hint_direction_follows_the_agent_through_the_host_loop(episodes):
+    """A text-only one-stage agent (no rendering) asks a route question, then turns and moves: each later Planner
+    prompt shows the hint as first spoken and where the hinted area lies from the pose of that decision (the
+    sector recomputed here from the trajectory's poses and the route's point, :func:`ignjax.sim.oracle.route_facts`),
+    and the direction changes as the agent turns."""
+    from ignjax.evaluate.runner import make_world
+    from ignjax.sim import oracle as O
+
+    es = episodes.subset([0])
+    sim = T.SimConfig(max_steps=6)
+    with ScriptedServer(policy=_hint_policy) as srv:
+        res = run_llm_agent(es, get_llm_agent("navgpt-naive"), _llm(srv), sim=sim, batch=1)
+    acts = {c["step"]: c["action"] for c in res.transcripts if c["action"] is not None}
+    assert acts[0][0] == ASK and acts[0][4] == 3 and [acts[s][0] for s in (1, 2, 3, 4)] == [MOVE] * 4
+    pose = np.asarray(res.trajectories.pose[0], np.float64)
+    spec = jax.tree.map(lambda a: a[0], es.specs)
+    point = np.asarray(O.route_facts(make_world(es, sim), spec, jnp.asarray(pose[0], jnp.float32))[4], np.float64)
+    prompts = {c["step"]: c["prompt"] for c in res.transcripts if c["role"] == "planner"}
+    hint = prompts[1].split("Active route hint: ")[1].split("\n")[0]
+    assert hint and "Active route hint" not in prompts[0]
+    said = []
+    for step in range(1, 6):
+        rel = np.arctan2(point[1] - pose[step, 1], point[0] - pose[step, 0]) - pose[step, 2]
+        sector = int(np.round(((rel + np.pi) % (2 * np.pi) - np.pi) / (np.pi / 4))) % 8
+        progress = int(res.trajectories.hint_progress[0, step - 1])
+        assert f"Active route hint: {hint}" in prompts[step]
+        if progress in (T.HINT_REACHED, T.HINT_STOP):
+            assert "Where the hinted area lies now" not in prompts[step]
+            continue
+        line = re.search(r"Where the hinted area lies now: (.*)\.", prompts[step]).group(1)
+        assert line == OT.SECTOR_PHRASES[sector], (step, line, sector)
+        said.append(line)
+        if step > 1:
+            assert f"Progress: {OT.hint_progress_text(progress)}" in prompts[step]
+    assert len(said) >= 3 and len(set(said)) >= 2
 
 
 SCHEDULE_SCRIPT = {1: _plan("move", direction="front", subgoal="the open doorway"),
