@@ -23,9 +23,10 @@ def dry_run(agent: LLMAgent, n_episodes: int, *, sim: T.SimConfig = T.SimConfig(
             llm: LLMConfig | None = None, costs=LOCKED_COSTS) -> dict:
     """What running ``agent`` on ``n_episodes`` episodes would send at most,
     before sending anything: requests (every decision a Planner call, every
-    decision a move for two-stage agents; with ``llm.paraphrase`` one
-    paraphrase per question, as many questions as the budget allows; re-asks
-    not counted), images, and
+    decision a move for two-stage agents; with ``self_questions`` one
+    self-check per decision; with ``llm.paraphrase`` one paraphrase per
+    question, as many questions as the budget allows; re-asks and the
+    Planner's correction after a self-check not counted), images, and
     an estimate of prompt tokens (text at 4 characters a token, images at one
     token per :data:`IMAGE_TOKEN_PX` square) and of completion tokens
     (``llm.max_tokens`` per request, the cap). The prompts are built from a
@@ -36,6 +37,7 @@ def dry_run(agent: LLMAgent, n_episodes: int, *, sim: T.SimConfig = T.SimConfig(
 
     sim = dataclasses.replace(sim, **sim_overrides(agent, llm))
     two_stage = bool(getattr(agent, "two_stage", False)) and agent.observation == "panel"
+    self_check = bool(getattr(agent, "self_questions", False)) and agent.observation == "panel"
     img = ImagePart(b"\xff\xd8\xff\xd9") if agent.observation == "panel" else None
     d = Decision(episode="dry-run", step=0, max_steps=sim.max_steps, goal="object", questions_left=sim.max_questions,
                  costs=tuple(costs), answers=(), last_move="", n_views=sim.n_views, view_fov=sim.view_hfov, panel=img,
@@ -57,13 +59,21 @@ def dry_run(agent: LLMAgent, n_episodes: int, *, sim: T.SimConfig = T.SimConfig(
     planner_tokens = text_tokens(req) + (panel_tokens if img is not None else 0)
     out = {"agent": agent.name, "episodes": n_episodes, "decisions_at_most": decisions,
            "planner_requests": decisions, "grounder_requests": decisions if two_stage else 0,
-           "images": (decisions if img is not None else 0) + (decisions if two_stage else 0),
+           "self_questioner_requests": decisions if self_check else 0,
+           "images": (decisions if img is not None else 0) + (decisions if two_stage else 0)
+           + (decisions if self_check else 0),
            "prompt_tokens_per_planner_request": planner_tokens}
     grounder_tokens = 0
     if two_stage:
         g = agent.grounder_request(d, ImagePart(b"\xff\xd8\xff\xd9"), "the centre of the open doorway", "")
         grounder_tokens = text_tokens(g) + view_tokens
         out["prompt_tokens_per_grounder_request"] = grounder_tokens
+    self_check_tokens = 0
+    if self_check:
+        from ignjax.agents.llm.self_questioner import request as self_check_request
+
+        self_check_tokens = text_tokens(self_check_request(d, ImagePart(b"\xff\xd8\xff\xd9"), "the object")) + view_tokens
+        out["prompt_tokens_per_self_questioner_request"] = self_check_tokens
     paraphrase_tokens = 0
     if llm is not None and llm.paraphrase and agent.may_ask:  # one per answer; a question per decision at most
         out["paraphrase_requests"] = n_episodes * (min(sim.max_questions, sim.max_steps) if sim.question_budget
@@ -72,8 +82,10 @@ def dry_run(agent: LLMAgent, n_episodes: int, *, sim: T.SimConfig = T.SimConfig(
         paraphrase_tokens = text_tokens(ChatRequest(messages=OT.paraphrase_messages(3, route),
                                                     schema=OT.PARAPHRASE_SCHEMA))
         out["prompt_tokens_per_paraphrase_request"] = paraphrase_tokens
-    out["requests"] = out["planner_requests"] + out["grounder_requests"] + out.get("paraphrase_requests", 0)
+    out["requests"] = (out["planner_requests"] + out["grounder_requests"] + out["self_questioner_requests"]
+                       + out.get("paraphrase_requests", 0))
     out["prompt_tokens"] = (decisions * planner_tokens + out["grounder_requests"] * grounder_tokens
+                            + out["self_questioner_requests"] * self_check_tokens
                             + out.get("paraphrase_requests", 0) * paraphrase_tokens)
     max_tokens = (llm.max_tokens if llm is not None else LLMConfig().max_tokens)
     out["completion_tokens_at_most"] = out["requests"] * max_tokens

@@ -68,7 +68,9 @@ Baselines in the style of the paper's adaptations (our reading of each, on
 this machinery; the paper's own code is not used): ``gta``
 (Planner-Grounder; instead of Spatial Memory a topological graph of places
 from the agent's own odometry, with visit counts and a loop alert, and a
-Planner that weighs directions before choosing), ``coin`` (no route questions),
+Planner that weighs directions before choosing), ``coin`` (no route questions; a
+self-check of each candidate before a confirmation or a stop, whose conflict
+with the Fact Base skips the question: :mod:`ignjax.agents.llm.self_questioner`),
 ``mapgpt`` (one stage: the Planner picks the grid cell itself, with a
 map-like text memory of places and their links), ``navgpt`` (one stage,
 text only: each view described from the simulator's perception, stated as
@@ -85,6 +87,8 @@ from ignjax.agents.llm.controller import RECOVERY_MOVES, TEXT_CHARS, TandemContr
 from ignjax.agents.llm.counterfactual import PROMPT as COUNTERFACTUAL_PROMPT
 from ignjax.agents.llm.counterfactual import counterfactual_error, with_counterfactuals
 from ignjax.agents.llm.graph_memory import MERGE_M, graph_text
+from ignjax.agents.llm.self_questioner import PROMPT as SELF_CHECK_PROMPT
+from ignjax.agents.llm.self_questioner import self_check
 from ignjax.sim import oracle_text as OT
 from ignjax.sim import types as T
 from ignjax.sim.views.compose import view_names
@@ -196,6 +200,9 @@ class Tandem(TandemController, LLMAgent):
             :mod:`ignjax.agents.llm.graph_memory`).
         counterfactual: the Planner's reply weighs directions before choosing
             (GTA-style; :mod:`ignjax.agents.llm.counterfactual`).
+        self_questions: a self-check of the candidate before a confirmation
+            or a stop (COIN-style; :mod:`ignjax.agents.llm.self_questioner`;
+            needs the panel observation).
         observation: ``"panel"`` or ``"text"`` (NavGPT-style captions from
             the simulator's perception).
         n_views: views of the panel (4, 8 or 12; the observation ablation).
@@ -208,20 +215,22 @@ class Tandem(TandemController, LLMAgent):
 
     def __init__(self, spatial_memory: bool = True, qa: bool = True, cost_aware: bool = True, safeguards: bool = True,
                  two_stage: bool = True, route_questions: bool = True, memory_style: str = "spatial",
-                 counterfactual: bool = False, observation: str = "panel", n_views: int | None = None,
-                 reasks: int = 2):
+                 counterfactual: bool = False, self_questions: bool = False, observation: str = "panel",
+                 n_views: int | None = None, reasks: int = 2):
         if observation not in ("panel", "text"):
             raise ValueError(f"observation must be 'panel' or 'text', got {observation!r}")
         if memory_style not in ("spatial", "map", "graph"):
             raise ValueError(f"memory_style must be 'spatial', 'map' or 'graph', got {memory_style!r}")
+        if self_questions and observation != "panel":
+            raise ValueError("self_questions reads the front view: it needs observation='panel'")
         if n_views not in (None, 4, 8, 12):
             raise ValueError(f"n_views must be 4, 8 or 12, got {n_views!r}")
         self.spatial_memory, self.qa, self.show_costs = bool(spatial_memory), bool(qa), bool(cost_aware)
         self.safeguards, self.two_stage, self.route_questions = bool(safeguards), bool(two_stage), bool(route_questions)
         self.memory_style, self.observation, self.n_views, self.reasks = memory_style, observation, n_views, int(reasks)
-        self.counterfactual = bool(counterfactual)
+        self.counterfactual, self.self_questions = bool(counterfactual), bool(self_questions)
         self.may_ask = self.qa
-        self.uses_views = self.two_stage and observation == "panel"
+        self.uses_views = (self.two_stage or self.self_questions) and observation == "panel"
 
     @property
     def writes_questions(self) -> bool:
@@ -283,6 +292,8 @@ class Tandem(TandemController, LLMAgent):
                  if self.counterfactual else "")
         if self.counterfactual:
             blocks.append(COUNTERFACTUAL_PROMPT)  # GTA-style: weigh alternatives before choosing
+        if self.self_questions:
+            blocks.append(SELF_CHECK_PROMPT)  # COIN-style: a self-check before a confirmation or a stop
         blocks.append(
             # block 4: output contract
             "Reply with one JSON object and nothing else, with every key present: 'reasoning' (short), 'task_phase' "
@@ -469,7 +480,10 @@ class Tandem(TandemController, LLMAgent):
             act = ruled[0]
             ctx.note_rule(*ruled[1:])
         else:
-            plan = await ctx.query(self.planner_request(m, d), lambda parsed, err: self._parse_plan(m, d, parsed, err))
+            req = self.planner_request(m, d)
+            plan = await ctx.query(req, lambda parsed, err: self._parse_plan(m, d, parsed, err))
+            if plan is not None and self.self_questions:
+                plan = await self_check(self, ctx, m, d, req, plan)
             if plan is None:
                 act = ctx.default(self.default_action(m, d))
                 m.history.append((d.step, "move", act, "(default after invalid replies)"))
@@ -478,13 +492,15 @@ class Tandem(TandemController, LLMAgent):
                 self._merge(m, d, parsed)
                 if act[0] == MOVE:
                     act = await self._ground(ctx, m, d, act, parsed)
-                elif act[0] == ASK and act[4] == 4:
-                    act = await self._ground_candidate(ctx, d, act, parsed)
-                elif act[0] == ASK and parsed.get("action") == "ask":  # not a stop turned into a confirmation
-                    question = clip(parsed.get("question"))
                 elif act[0] == ASK:
-                    ctx.note_rule("confirm before stop", "the Planner chose stop without evidence (no confirmed "
-                                  "target, no hint that it is near): ask a confirmation question (type 4) instead")
+                    if act[4] == 4:  # the candidate's cell on the front view
+                        act = await self._ground_candidate(ctx, d, act, parsed)
+                    if parsed.get("action") == "ask":  # not a stop turned into a confirmation
+                        question = clip(parsed.get("question"))
+                    else:
+                        ctx.note_rule("confirm before stop", "the Planner chose stop without evidence (no confirmed "
+                                      "target, no hint that it is near): ask a confirmation question (type 4) "
+                                      "instead")
         self._record(m, d, act, question)
         if act[0] == ASK and question:
             ctx.note_question(question)
@@ -570,9 +586,10 @@ TANDEM_AGENTS = {
                            "counterfactual reasoning, cost-aware", memory_style="graph", counterfactual=True),
     "gta-naive": _variant("gta-naive", "GTA-style, naive-QA", memory_style="graph", counterfactual=True,
                           cost_aware=False, safeguards=False),
-    "coin": _variant("coin", "COIN-style: no route questions, cost-aware", route_questions=False),
-    "coin-naive": _variant("coin-naive", "COIN-style, naive-QA", route_questions=False, cost_aware=False,
-                           safeguards=False),
+    "coin": _variant("coin", "COIN-style: no route questions, a self-check of each candidate against the Fact Base "
+                             "before a confirmation or a stop, cost-aware", route_questions=False, self_questions=True),
+    "coin-naive": _variant("coin-naive", "COIN-style, naive-QA (route questions allowed)", self_questions=True,
+                           cost_aware=False, safeguards=False),
     "mapgpt": _variant("mapgpt", "MapGPT-style: one stage, map-like text memory, cost-aware", two_stage=False,
                        memory_style="map"),
     "mapgpt-naive": _variant("mapgpt-naive", "MapGPT-style, naive-QA", two_stage=False, memory_style="map",
