@@ -149,8 +149,8 @@ def _settings_hash(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, sim: T.SimCo
 
 
 def observation_text(obs: dict, r: int, categories: tuple[str, ...], names: tuple[str, ...]) -> str:
-    """Row ``r`` of the symbolic observation as text (the ``text``
-    observation of MLLM agents): per view, the free distance ahead and the
+    """Row ``r`` of the symbolic observation as text (the ``text`` observation of MLLM agents, an ablation:
+    ground truth, instance ids, metres and the room label included): per view, the free distance ahead and the
     objects in sight with their perceived attributes."""
     lines = []
     fs = obs["free_space"][r]
@@ -222,8 +222,7 @@ def _outcome_rows(world, states):
 class _Context:
     """What an agent's :meth:`~ignjax.agents.llm.agent.LLMAgent.decide` may
     use for one decision: model calls with re-asks (:meth:`query`, counted
-    in the episode's accounting and transcript) and the Grounder image of a
-    view (:meth:`view_image`)."""
+    in the episode's accounting and transcript) and the image of a view (:meth:`view_image`)."""
 
     def __init__(self, loop: "HostLoop", client: ChatClient, ep: _Episode, d: Decision):
         self._loop, self._client, self._ep, self._d = loop, client, ep, d
@@ -255,8 +254,9 @@ class _Context:
         n = self._loop.agent.reasks if reasks is None else int(reasks)
         return await self._loop._query(self._client, self._ep, self._d, request, parse, role, n)
 
-    def view_image(self, k: int) -> ImagePart:
-        """View ``k`` of this decision with the numbered 8x8 grid, encoded (the Grounder's image)."""
+    def view_image(self, k: int, grid: bool = True) -> ImagePart:
+        """View ``k`` of this decision, encoded: with the numbered 8x8 grid (the Grounder's image, kept with the
+        episode's saved images), or without it (``grid=False``: the captioner's image, not kept)."""
         from ignjax.sim.views.compose import grounder_images
         from ignjax.sim.views.encode import encode_images
 
@@ -265,10 +265,10 @@ class _Context:
             raise ValueError("this decision carries no rendered views")
         if not 0 <= int(k) < rgb.shape[0]:
             raise ValueError(f"view {k} is outside the {rgb.shape[0]} views")
-        fmt = self._loop.views.image_format
-        data = encode_images(grounder_images(rgb[int(k)][None]), fmt, self._loop.views.quality)[0]
+        fmt, one = self._loop.views.image_format, rgb[int(k)][None]
+        data = encode_images(grounder_images(one) if grid else one, fmt, self._loop.views.quality)[0]
         img = ImagePart(data, "image/jpeg" if fmt == "jpeg" else "image/png")
-        if self._ep.index < self._loop.save_images:
+        if grid and self._ep.index < self._loop.save_images:
             self._ep.images.append((self._d.step, img, "grounder"))
         return img
 
@@ -299,12 +299,12 @@ class HostLoop:
         self.names = self._view_names()
         self.categories = es.bank.categories
         self.renderer, self._own_renderer = None, False
-        if agent.observation == "panel" and renderer is not None:
+        if agent.renders and renderer is not None:
             if renderer.bank is not es.bank or renderer.sim != sim or renderer.config != views:
                 raise ConfigError(None, "renderer", "the given renderer was made for another bank, simulator settings "
                                                     "or view settings")
             self.renderer = renderer
-        elif agent.observation == "panel":  # made before the first request: render workers start here
+        elif agent.renders:  # made before the first request: render workers start here
             from ignjax.sim.views import ViewRenderer
 
             self.renderer, self._own_renderer = ViewRenderer(es.bank, sim, views), True
@@ -341,7 +341,7 @@ class HostLoop:
                        "hint_progress": int(ans.hint_progress[r]), "blocked": obs["blocked"][r].tolist(),
                        "moved": float(obs["last_move"][r])}
             rec = self.es.records[ep.index]
-            text = None if self.agent.observation == "panel" else observation_text(obs, r, self.categories, self.names)
+            text = observation_text(obs, r, self.categories, self.names) if self.agent.observation == "text" else None
             last_kind = ep.calls[-1]["action"][0] if ep.calls and ep.calls[-1].get("action") else -1
             out.append({"row": r, "scene": int(scene[r]), "pose": pose[r].copy(), "decision": dict(
                 episode=rec["episode_id"], step=int(step[r]), max_steps=self.sim.max_steps,
@@ -355,7 +355,7 @@ class HostLoop:
     def _decisions(self, items: list[dict], slots) -> list[tuple[int, Decision]]:
         """``(row, Decision)`` of prepared ``items`` (render, compose and encode their panels)."""
         panels = [None] * len(items)
-        if self.agent.observation == "panel" and items:
+        if self.agent.renders and items:
             from ignjax.sim.views.encode import encode_images
 
             v = self.renderer.render(np.asarray([it["scene"] for it in items]),
