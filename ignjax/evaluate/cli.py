@@ -402,8 +402,8 @@ def run(args, settings: dict | None = None, popts: PR.ProcessOptions = PR.Proces
 
 def _image_size(st: dict) -> int | None:
     """Pixels per side of the views the MLLM agents were shown (``views.size``); None when no agent rendered."""
-    panel = [a for a in st["llm_agents"] if getattr(a, "observation", None) == "panel"]
-    return st["views"].size if panel else None
+    rendered = [a for a in st["llm_agents"] if a.renders]  # a panel, or views for a Grounder or a captioner
+    return st["views"].size if rendered else None
 
 
 def _fields(obj) -> dict:

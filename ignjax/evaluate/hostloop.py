@@ -159,12 +159,11 @@ def _settings_hash(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, sim: T.SimCo
 
 
 def observation_text(obs: dict, r: int, categories: tuple[str, ...], names: tuple[str, ...], cells=None) -> str:
-    """Row ``r`` of the symbolic observation as text (the ``text``
-    observation of MLLM agents): per view, the free distance ahead and the
+    """Row ``r`` of the symbolic observation as text (the ``text`` observation of MLLM agents, an ablation:
+    ground truth, instance ids, metres and the room label included): per view, the free distance ahead and the
     objects in sight with their perceived attributes; with ``cells`` (K, 2)
-    (:func:`ignjax.evaluate.candidates.front_cells`), the front-view grid
-    cell of each object that appears in the front view (what a Type-4
-    question names)."""
+    (:func:`ignjax.evaluate.candidates.front_cells`), the front-view grid cell of each object that appears in the
+    front view (what a Type-4 question names)."""
     lines = []
     fs = obs["free_space"][r]
     handles, cats, views, ranges, attrs = (obs[k][r] for k in ("visible_handle", "visible_category", "visible_view",
@@ -237,8 +236,7 @@ def _outcome_rows(world, states):
 class _Context:
     """What an agent's :meth:`~ignjax.agents.llm.agent.LLMAgent.decide` may
     use for one decision: model calls with re-asks (:meth:`query`, counted
-    in the episode's accounting and transcript) and the Grounder image of a
-    view (:meth:`view_image`)."""
+    in the episode's accounting and transcript) and the image of a view (:meth:`view_image`)."""
 
     def __init__(self, loop: "HostLoop", client: ChatClient, ep: _Episode, d: Decision):
         self._loop, self._client, self._ep, self._d = loop, client, ep, d
@@ -270,8 +268,9 @@ class _Context:
         n = self._loop.agent.reasks if reasks is None else int(reasks)
         return await self._loop._query(self._client, self._ep, self._d, request, parse, role, n)
 
-    def view_image(self, k: int) -> ImagePart:
-        """View ``k`` of this decision with the numbered 8x8 grid, encoded (the Grounder's image)."""
+    def view_image(self, k: int, grid: bool = True) -> ImagePart:
+        """View ``k`` of this decision, encoded: with the numbered 8x8 grid (the Grounder's image, kept with the
+        episode's saved images), or without it (``grid=False``: the captioner's image, not kept)."""
         from ignjax.sim.views.compose import grounder_images
         from ignjax.sim.views.encode import encode_images
 
@@ -280,10 +279,10 @@ class _Context:
             raise ValueError("this decision carries no rendered views")
         if not 0 <= int(k) < rgb.shape[0]:
             raise ValueError(f"view {k} is outside the {rgb.shape[0]} views")
-        fmt = self._loop.views.image_format
-        data = encode_images(grounder_images(rgb[int(k)][None]), fmt, self._loop.views.quality)[0]
+        fmt, one = self._loop.views.image_format, rgb[int(k)][None]
+        data = encode_images(grounder_images(one) if grid else one, fmt, self._loop.views.quality)[0]
         img = ImagePart(data, "image/jpeg" if fmt == "jpeg" else "image/png")
-        if self._ep.index < self._loop.save_images:
+        if grid and self._ep.index < self._loop.save_images:
             self._ep.images.append((self._d.step, img, "grounder"))
         return img
 
@@ -316,12 +315,12 @@ class HostLoop:
         self._structural = np.asarray(es.bank.instances.structural)
         self._centers = np.asarray(es.bank.instances.center)
         self.renderer, self._own_renderer = None, False
-        if agent.observation == "panel" and renderer is not None:
+        if agent.renders and renderer is not None:
             if renderer.bank is not es.bank or renderer.sim != sim or renderer.config != views:
                 raise ConfigError(None, "renderer", "the given renderer was made for another bank, simulator settings "
                                                     "or view settings")
             self.renderer = renderer
-        elif agent.observation == "panel":  # made before the first request: render workers start here
+        elif agent.renders:  # made before the first request: render workers start here
             from ignjax.sim.views import ViewRenderer
 
             self.renderer, self._own_renderer = ViewRenderer(es.bank, sim, views), True
@@ -378,7 +377,7 @@ class HostLoop:
     def _decisions(self, items: list[dict], slots) -> list[tuple[int, Decision]]:
         """``(row, Decision)`` of prepared ``items`` (render, compose and encode their panels)."""
         panels, v = [None] * len(items), None
-        if self.agent.observation == "panel" and items:
+        if self.agent.renders and items:
             from ignjax.sim.views.encode import encode_images
 
             v = self.renderer.render(np.asarray([it["scene"] for it in items]),

@@ -57,8 +57,9 @@ Written by agents that see images or call models (optional; shown when present):
     one JSON object per line, one line per model call, with the keys
     ``agent`` (str), ``episode`` (the episode id), ``step`` (int, 0-based
     planner step), ``role`` (``"planner"``, ``"grounder"``, ``"controller"``:
-    a decision taken without a model call, or ``"paraphrase"``: an oracle
-    answer reworded by the model), ``prompt``
+    a decision taken without a model call, ``"paraphrase"``: an oracle
+    answer reworded by the model, or ``"caption"``: one view described by
+    the model for an agent that reads captions), ``prompt``
     (str, the text sent), ``reply`` (str, the raw reply), ``parsed`` (any
     JSON value: the parse result, null when parsing failed), ``retries``
     (int, or a list of ``{"reply": str, "error": str}`` earlier attempts)

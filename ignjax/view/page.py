@@ -103,7 +103,7 @@ def run_entry(run: Run, agent: str, i: int, rec: dict, truth: list[list[int]]) -
     if "blocked" in tr:
         e["bl"] = [int(sum(1 << k for k, b in enumerate(m) if b)) for m in tr["blocked"][i, :n]]
     if "n_questions" in tr:
-        nq = np.asarray(tr["n_questions"][i, :n], np.int64)
+        nq = np.asarray(tr["n_questions"][i, :n], np.int64).reshape(-1, 4)  # (0, 4) where no episode of a run stepped
         e["nq"] = [int(v) for v in nq.reshape(-1)]
         e["dc"] = [round(float(v), 3) for v in M.question_discount(nq, meta["costs"])]
     if "refused" in tr:

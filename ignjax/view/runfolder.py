@@ -36,9 +36,9 @@ IMAGE_NAME = re.compile(r"^(\d+)_(panel|grounder)(?:_\d+)?\.(jpg|jpeg|png)$", re
 Grounder's image was named like the panel's; see the module docstring of :mod:`ignjax.view`)."""
 IMAGE_KINDS = ("panel", "grounder")
 TRANSCRIPT_KEYS = ("agent", "episode", "step", "role", "prompt", "reply", "parsed", "retries", "error")
-ROLES = ("planner", "grounder", "controller", "paraphrase")
+ROLES = ("planner", "grounder", "controller", "paraphrase", "caption")
 """Transcript roles: a Planner or Grounder call, a decision the agent's controller took without a model call, a
-rewording of an oracle answer (``llm.paraphrase``)."""
+rewording of an oracle answer (``llm.paraphrase``), a caption of one view (``navgpt``)."""
 
 
 @dataclass

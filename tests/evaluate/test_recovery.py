@@ -95,7 +95,7 @@ def _sent_line(err: str, agent: str) -> str:
     return next(line for line in err.splitlines() if line.startswith(f"{agent}: ") and "sent in this run" in line)
 
 
-def test_server_killed_mid_run_then_the_same_command_retries_the_failures(tmp_path, capsys):
+def test_server_killed_mid_run_then_the_same_command_retries_the_failures(rendering, tmp_path, capsys):
     with ScriptedServer(policy=_planner_move, latency=0.05) as srv:
         url, cache = srv.base_url, tmp_path / "cache"
         args = _evaluate(tmp_path / "run", url, cache)
@@ -125,7 +125,13 @@ def test_server_killed_mid_run_then_the_same_command_retries_the_failures(tmp_pa
         second = capsys.readouterr()
         rows = _rows(tmp_path / "run" / "outcomes.csv")
         assert {r["stop_reason"] for r in rows} <= {"stop", "step_budget"} and not any(r["failure"] for r in rows)
-        assert sum(int(r["cache_hits"]) for r in rows) == len(answered)
+        again = _calls(tmp_path / "run", "navgpt")
+        hits = [c["request_hash"] for c in again if c["cache_hit"]]
+        assert sum(int(r["cache_hits"]) for r in rows) == len(hits)
+        # every reply the first run got came from the cache; the other hits are requests this run sent once and met
+        # again (a caption of a view equal to another: the captioner's prompt does not name the direction)
+        assert {c["request_hash"] for c in answered} <= set(hits)
+        assert set(hits) <= {c["request_hash"] for c in answered + again if c["request_hash"] and not c["cache_hit"]}
         assert sum(int(r["requests"]) for r in rows) == srv.stats()["requests"] > 0
         assert f"0 episodes kept from an earlier run, {N} run again after a model failure" in second.err
         assert "ended by a model failure (first" not in second.err
@@ -147,13 +153,14 @@ def test_server_killed_mid_run_then_the_same_command_retries_the_failures(tmp_pa
 
 
 def test_controller_records_name_the_rule_and_what_it_asked(tmp_path, episodes):
-    """``navgpt`` (text only: no rendering) moving on every Planner reply: the controller asks the early questions
+    """``navgpt`` on the ground-truth text observation (its ``observation="text"`` ablation: no rendering, no
+    captions) moving on every Planner reply: the controller asks the early questions
     of the schedule on its own (the region fact at turn 2, the appearance fact at turn 5, which spend this setting's
     two questions, so the recovery rule has none left to ask); each such decision's transcript record names the rule
     and what it asked."""
     with ScriptedServer(policy=_planner_move) as srv:
-        res = run_llm_agent(episodes, get_llm_agent("navgpt"), _llm(srv, tmp_path / "c"), sim=SIM,
-                            views=ViewConfig(size=64), batch=N)
+        res = run_llm_agent(episodes, get_llm_agent("navgpt", observation="text"), _llm(srv, tmp_path / "c"),
+                            sim=SIM, views=ViewConfig(size=64), batch=N)
     ctrl = [c for c in res.transcripts if c["role"] == "controller"]
     assert len({c["episode"] for c in ctrl}) == N, [(c["role"], c.get("rule")) for c in res.transcripts]
     for c in ctrl:
@@ -215,7 +222,7 @@ def test_the_viewer_reads_the_grounder_images_the_run_writes(rendering, tmp_path
     assert read_run(tmp_path / "run", episodes=1).images[("tandem", eid)][0]["grounder"].name == "000_grounder_0.jpg"
 
 
-def test_sweep_exits_3_on_model_failures_and_resume_retries_them(tmp_path, capsys):
+def test_sweep_exits_3_on_model_failures_and_resume_retries_them(rendering, tmp_path, capsys):
     from ignjax.sweep.cli import main as sweep_main
 
     agent = "navgpt"

@@ -1,7 +1,7 @@
 """README: the API key named by ``--llm-key-env`` "is only ever put in the
 ``Authorization`` header: never in logs, outcomes, ``run.json``,
 checkpoints, transcripts or error messages". One ``python -m
-ignjax.evaluate`` (in process) of the text-only ``navgpt`` agent against the
+ignjax.evaluate`` (in process) of the ``navgpt`` agent (a caption call per view, a Planner call) against the
 scripted server (a real HTTP server on 127.0.0.1), with a server error on one
 request so a retry is logged: the server received the key as a bearer token,
 and no file of the run folder (response cache included) and no line the run
@@ -28,13 +28,13 @@ def _forms(key: str) -> list[bytes]:
     return [raw, base64.b64encode(raw), base64.urlsafe_b64encode(raw), raw.hex().encode()]
 
 
-def test_api_key_reaches_the_server_and_no_file_of_the_run(tmp_path, monkeypatch, capfd, caplog):
+def test_api_key_reaches_the_server_and_no_file_of_the_run(rendering, tmp_path, monkeypatch, capfd, caplog):
     key = "sk-ignjax-" + secrets.token_hex(16)
     monkeypatch.setenv(KEY_ENV, key)
     caplog.set_level(logging.DEBUG)
     out = tmp_path / "run"
     with ScriptedServer(faults="500@2") as srv:
-        argv = ["--episodes", str(EPISODES), "--agent", "navgpt", "--limit", "1", "--set", "sim.max_steps=3",
+        argv = ["--episodes", str(EPISODES), "--agent", "navgpt", "--limit", "1", "--set", "sim.max_steps=3", "--set", "views.size=64",
                 "--llm-endpoint", srv.base_url, "--llm-model", srv.model, "--llm-key-env", KEY_ENV,
                 "--out", str(out), "--quiet"]
         assert evaluate(argv) == 0
@@ -44,7 +44,7 @@ def test_api_key_reaches_the_server_and_no_file_of_the_run(tmp_path, monkeypatch
     names = {p.relative_to(out).as_posix() for p in files}
     assert {"run.json", "outcomes.csv", "transcripts/navgpt.jsonl", "llm/navgpt.progress.jsonl",
             "llm_cache/llm_cache.sqlite"} <= names, sorted(names)
-    assert json.loads((out / "run.json").read_text())["image_size"] is None  # navgpt reads text: no view rendered
+    assert json.loads((out / "run.json").read_text())["image_size"] == 64  # the views navgpt's captioner saw
     printed = capfd.readouterr()
     assert "retry 1" in caplog.text
     texts = {p.relative_to(out).as_posix(): p.read_bytes() for p in files}

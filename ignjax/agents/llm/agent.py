@@ -6,8 +6,9 @@ An MLLM agent runs on the host, between the simulator's jitted steps
 :class:`Decision` (everything the agent may read, all of it allowed to the
 paper's Planner: the instruction, the remaining budgets, the question costs,
 the oracle's answers so far as text, the executor's feedback on the last
-move, and the Planner panel or a text rendering of the symbolic
-observation). The agent turns it into a :class:`~ignjax.agents.llm.client.ChatRequest`,
+move, and the Planner panel or the rendered views; the exception is the
+``"text"`` observation, an ablation that reads the simulator's ground-truth
+perception in words, which the paper's Planner never gets). The agent turns it into a :class:`~ignjax.agents.llm.client.ChatRequest`,
 and the model's reply into an action. Nothing the paper withholds from the
 Planner (world coordinates, path lengths, compass headings, target
 distances) is in a :class:`Decision`.
@@ -126,10 +127,14 @@ class Decision:
         view_fov: horizontal field of view of each view, degrees (the
             simulator's ``view_hfov``; 0: the default for ``n_views``, 90
             for 4 and 8 views, 30 for 12).
-        panel: the Planner panel, encoded (None for text observations).
-        observation: the symbolic observation as text (None with a panel).
+        panel: the Planner panel, encoded (None when nothing is rendered).
+        observation: the symbolic observation as text (the ``"text"``
+            observation: ground truth, with instance ids, metres and the room
+            label); None otherwise (a ``"caption"`` agent fills in its own
+            captions).
         views: the rendered views, (N, S, S, 3) uint8, for agents that show
-            one view on its own (the Grounder; :attr:`LLMAgent.uses_views`).
+            one view on its own (the Grounder, the captioner;
+            :attr:`LLMAgent.uses_views`).
         percept: what the agent's controller may read besides the prompt
             (never shown to the model as numbers): ``open`` (8,) metres of free
             floor in each of the observation's 8 sectors (view layout of 8,
@@ -189,7 +194,10 @@ class LLMAgent:
     Attributes:
         name: registry name.
         description: one line for ``--help``.
-        observation: ``"panel"`` (rendered images) or ``"text"``.
+        observation: ``"panel"`` (rendered images), ``"caption"`` (rendered
+            views, each described by the model before the decision:
+            :mod:`ignjax.agents.llm.caption`) or ``"text"`` (the simulator's
+            ground-truth perception in words: an ablation, never a camera's).
         reasks: corrections before the default action.
         show_costs: the prompt lists the question costs (the cost-aware setting).
         may_ask: the agent may ask questions at all.
@@ -208,6 +216,11 @@ class LLMAgent:
     may_ask = True
     uses_views = False
     writes_questions = False
+
+    @property
+    def renders(self) -> bool:
+        """The host loop renders this agent's views (every observation but ``"text"``)."""
+        return self.observation != "text"
 
     def start(self, episode: str) -> EpisodeMemory:
         return EpisodeMemory()
@@ -286,8 +299,10 @@ def _history_text(memory: EpisodeMemory, names, limit: int = 6) -> str:
 
 class VlmAgent(LLMAgent):
     """``vlm``: one request per decision (single stage, no memory beyond
-    the recent moves): the instruction, the Planner panel (or the text
-    observation), the answers so far, the budgets; the reply is one JSON
+    the recent moves): the instruction, the Planner panel (or, with
+    ``observation="text"``, the simulator's ground-truth perception as text,
+    instance ids, metres and room label included: an ablation with perception
+    an oracle), the answers so far, the budgets; the reply is one JSON
     decision (module docstring)."""
 
     name = "vlm"

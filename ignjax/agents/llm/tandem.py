@@ -11,7 +11,8 @@ One decision of :class:`Tandem`:
    a route hint while nothing the agent knows places it near the goal,
    questions left) asks a route question (Type 3).
 2. **Planner** (one request): the instruction, the N-view panel (or, for the
-   text-only baseline, each view described from the simulator's perception),
+   NavGPT-style baseline, each view described in words by a captioning
+   request per view to the same model first: :mod:`ignjax.agents.llm.caption`),
    the Fact Base (the oracle's answers, by type), the active route hint
    (as first spoken, where the hinted area lies now relative to the agent's
    facing, and its progress: :func:`hint_block`), the follow-up state, the
@@ -73,15 +74,22 @@ self-check of each candidate before a confirmation or a stop, whose conflict
 with the Fact Base skips the question: :mod:`ignjax.agents.llm.self_questioner`),
 ``mapgpt`` (one stage: the Planner picks the grid cell itself, with a
 map-like text memory of places and their links), ``navgpt`` (one stage,
-text only: each view described from the simulator's perception, stated as
-such in the prompt); each in a cost-aware form (costs shown, safeguards on)
-and a naive-QA form (``-naive``).
+text only: the Planner reads a caption of each view, written by the same
+model from the rendered view before the Planner request; it picks the cell
+from the grid convention in words, without an image); each in a cost-aware
+form (costs shown, safeguards on) and a naive-QA form (``-naive``). The
+``"text"`` observation (each view described from the simulator's
+ground-truth perception, instance ids, metres and the room label included)
+is kept as an option for ablations and tests; no named agent uses it.
 """
 
 from __future__ import annotations
 
+import dataclasses
+
 from ignjax.agents.llm.agent import (ASK, MOVE, MOVED_M, QUESTION_HELP, QUESTION_NAMES, STOP, Decision, LLMAgent,
                                      orientation_text)
+from ignjax.agents.llm.caption import describe_views
 from ignjax.agents.llm.client import ChatRequest
 from ignjax.agents.llm.controller import RECOVERY_MOVES, TEXT_CHARS, TandemController, TandemMemory, clip, rear
 from ignjax.agents.llm.counterfactual import PROMPT as COUNTERFACTUAL_PROMPT
@@ -203,8 +211,10 @@ class Tandem(TandemController, LLMAgent):
         self_questions: a self-check of the candidate before a confirmation
             or a stop (COIN-style; :mod:`ignjax.agents.llm.self_questioner`;
             needs the panel observation).
-        observation: ``"panel"`` or ``"text"`` (NavGPT-style captions from
-            the simulator's perception).
+        observation: ``"panel"``, ``"caption"`` (NavGPT-style: one
+            captioning request per view, then the Planner reads the captions;
+            :mod:`ignjax.agents.llm.caption`) or ``"text"`` (the simulator's
+            ground-truth perception in words: an ablation).
         n_views: views of the panel (4, 8 or 12; the observation ablation).
         reasks: corrections before the default action.
     """
@@ -217,8 +227,8 @@ class Tandem(TandemController, LLMAgent):
                  two_stage: bool = True, route_questions: bool = True, memory_style: str = "spatial",
                  counterfactual: bool = False, self_questions: bool = False, observation: str = "panel",
                  n_views: int | None = None, reasks: int = 2):
-        if observation not in ("panel", "text"):
-            raise ValueError(f"observation must be 'panel' or 'text', got {observation!r}")
+        if observation not in ("panel", "caption", "text"):
+            raise ValueError(f"observation must be 'panel', 'caption' or 'text', got {observation!r}")
         if memory_style not in ("spatial", "map", "graph"):
             raise ValueError(f"memory_style must be 'spatial', 'map' or 'graph', got {memory_style!r}")
         if self_questions and observation != "panel":
@@ -230,7 +240,7 @@ class Tandem(TandemController, LLMAgent):
         self.memory_style, self.observation, self.n_views, self.reasks = memory_style, observation, n_views, int(reasks)
         self.counterfactual, self.self_questions = bool(counterfactual), bool(self_questions)
         self.may_ask = self.qa
-        self.uses_views = (self.two_stage or self.self_questions) and observation == "panel"
+        self.uses_views = ((self.two_stage or self.self_questions) and observation == "panel") or observation == "caption"
 
     @property
     def writes_questions(self) -> bool:
@@ -258,6 +268,10 @@ class Tandem(TandemController, LLMAgent):
         see = (f"one image of {d.n_views} camera views around you, each {d.view_fov:g} degrees wide and labelled with its "
                f"direction ({', '.join(names)}), arranged as a map around a centre cell: front is up, left is left"
                if self.observation == "panel" else
+               f"a written description of what each of your {d.n_views} directions shows ({', '.join(names)}); each "
+               f"was written by a captioning model that looked at that direction's camera view ({d.view_fov:g} degrees "
+               "wide) and may miss or misname things; you do not see the images"
+               if self.observation == "caption" else
                f"a written description of what each of your {d.n_views} directions shows ({', '.join(names)}); the "
                "descriptions come from the simulator's perception, not from a camera")
         blocks = [
@@ -282,10 +296,11 @@ class Tandem(TandemController, LLMAgent):
                 self.memory_intro(detail=False)
                 + "You cannot ask questions: the target's description is given in the Fact Base. Stop when you are "
                 "next to the target. Avoid going back and forth.")
-        cell = (" and 'col', 'row': the cell of the grid on that view to walk toward (columns 1-8 left to right, "
-                "rows 1-8 bottom to top; rows 1-3 are the floor ahead, higher rows lie further away or on walls); "
-                "for a confirmation question (type 4), the cell of your front view that shows the object you ask "
-                "about" if not self.two_stage else
+        cell = (" and 'col', 'row': the cell of the grid on that view to walk toward (" + (
+                "the view is divided into an 8x8 grid you do not see; " if self.observation != "panel" else "")
+                + "columns 1-8 left to right, rows 1-8 bottom to top; rows 1-3 are the floor ahead, higher rows lie "
+                "further away or on walls); for a confirmation question (type 4), the cell of your front view that "
+                "shows the object you ask about" if not self.two_stage else
                 "; for a confirmation question (type 4), 'subgoal' names the object you ask about, which must be in "
                 "your front view (a stop without confirmation becomes such a question about your subgoal)")
         weigh = ("'counterfactuals' (the directions you weighed, each with 'direction' and 'expected'), "
@@ -385,7 +400,7 @@ class Tandem(TandemController, LLMAgent):
             parts.append(f"Last move: {d.last_move}")
         parts.append(orientation_text(d))
         parts.append(f"Turn {d.step + 1} of at most {d.max_steps}; questions left: {d.questions_left if self.qa else 0}.")
-        parts.append(f"What you see:\n{d.observation}" if self.observation == "text" else "Your views follow.")
+        parts.append("Your views follow." if self.observation == "panel" else f"What you see:\n{d.observation}")
         return "\n\n".join(parts)
 
     def planner_request(self, m: TandemMemory, d: Decision) -> ChatRequest:
@@ -480,6 +495,8 @@ class Tandem(TandemController, LLMAgent):
             act = ruled[0]
             ctx.note_rule(*ruled[1:])
         else:
+            if self.observation == "caption":  # the captioner first: one request per view (ignjax.agents.llm.caption)
+                d = dataclasses.replace(d, observation=await describe_views(ctx, d))
             req = self.planner_request(m, d)
             plan = await ctx.query(req, lambda parsed, err: self._parse_plan(m, d, parsed, err))
             if plan is not None and self.self_questions:
@@ -594,9 +611,9 @@ TANDEM_AGENTS = {
                        memory_style="map"),
     "mapgpt-naive": _variant("mapgpt-naive", "MapGPT-style, naive-QA", two_stage=False, memory_style="map",
                              cost_aware=False, safeguards=False),
-    "navgpt": _variant("navgpt", "NavGPT-style: one stage, text-only views from the simulator's perception, "
-                                 "cost-aware", two_stage=False, observation="text"),
-    "navgpt-naive": _variant("navgpt-naive", "NavGPT-style, naive-QA", two_stage=False, observation="text",
+    "navgpt": _variant("navgpt", "NavGPT-style: one stage, text only: each view captioned by the model first, "
+                                 "cost-aware", two_stage=False, observation="caption"),
+    "navgpt-naive": _variant("navgpt-naive", "NavGPT-style, naive-QA", two_stage=False, observation="caption",
                              cost_aware=False, safeguards=False),
 }
 """The MLLM agents of Table 1 and the ablations, by name (module docstring)."""

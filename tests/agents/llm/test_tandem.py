@@ -517,14 +517,16 @@ def test_baselines_send_what_they_should(episodes, name):
     assert set(res.outcomes.stop_reason.tolist()) <= {T.STOPPED, T.OUT_OF_STEPS}
     images = [sum(p.get("type") == "image_url" for m in r["messages"] if isinstance(m["content"], list)
                   for p in m["content"]) for r in seen]
-    planner = [r for r in seen if r["response_format"]["json_schema"]["name"] == "planner_decision"]
+    kinds = [r["response_format"]["json_schema"]["name"] for r in seen]
+    planner = [r for r, k in zip(seen, kinds) if k == "planner_decision"]
     system = planner[0]["messages"][0]["content"]
-    if name == "navgpt":
-        assert sum(images) == 0 and "simulator's perception" in system
+    if name == "navgpt":  # text only: the Planner reads captions, each from one view's image (test_caption)
+        assert [n for n, k in zip(images, kinds) if k == "planner_decision"] == [0] * len(planner)
+        assert all(n == 1 for n, k in zip(images, kinds) if k == "view_caption") and "captioning model" in system
     else:
         assert all(n == 1 for n in images)
     if name in ("navgpt", "mapgpt"):
-        assert len(planner) == len(seen)  # one stage: no Grounder
+        assert "grounder_cell" not in kinds  # one stage: no Grounder
         assert "col" in planner[0]["response_format"]["json_schema"]["schema"]["properties"]
     if name == "gta":  # the place graph in every Planner request, the counterfactual field in its schema
         assert all("Place graph" in _texts(r) for r in planner)
@@ -589,7 +591,9 @@ def test_dry_run_counts_before_sending(capsys):
     rows = {r["agent"]: r for r in map(json.loads, capsys.readouterr().out.splitlines())}
     t, n, v12 = rows["tandem"], rows["navgpt"], rows["tandem-12v"]
     assert t["planner_requests"] == t["grounder_requests"] == 50 and t["images"] == 100
-    assert n["grounder_requests"] == 0 and n["images"] == 0 and n["requests"] == 50
+    # navgpt: no Grounder, one caption request (and image) per view per decision
+    assert n["grounder_requests"] == 0 and n["caption_requests"] == n["images"] == 400 and n["requests"] == 450
+    assert n["prompt_tokens_per_caption_request"] > 0 and t["caption_requests"] == 0
     assert v12["prompt_tokens_per_planner_request"] > t["prompt_tokens_per_planner_request"]  # a larger panel
     assert t["cost_usd_at_most"] == pytest.approx((t["prompt_tokens"] + 2 * t["completion_tokens_at_most"]) / 1e6)
     assert rows["random"]["requests"] == 0
