@@ -432,7 +432,7 @@ def test_route_hint_direction_follows_the_agent_through_the_host_loop(episodes):
     es = episodes.subset([0])
     sim = T.SimConfig(max_steps=6)
     with ScriptedServer(policy=_hint_policy) as srv:
-        res = run_llm_agent(es, get_llm_agent("navgpt-naive"), _llm(srv), sim=sim, batch=1)
+        res = run_llm_agent(es, get_llm_agent("navgpt-naive", observation="text"), _llm(srv), sim=sim, batch=1)
     acts = {c["step"]: c["action"] for c in res.transcripts if c["action"] is not None}
     assert acts[0][0] == ASK and acts[0][4] == 3 and [acts[s][0] for s in (1, 2, 3, 4)] == [MOVE] * 4
     pose = np.asarray(res.trajectories.pose[0], np.float64)
