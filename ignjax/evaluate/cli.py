@@ -329,7 +329,7 @@ def run(args, settings: dict | None = None, popts: PR.ProcessOptions = PR.Proces
 
     st = settings or check_settings(args, popts)
     agents, sim, out_dir, llm, views = st["agents"], st["sim"], st["out_dir"], st["llm"], st["views"]
-    thresholds, costs = st["thresholds"], st["costs"]
+    costs = st["costs"]
     llm_names = {a.name for a in st["llm_agents"]}
     if args.dry_run:
         return _dry_run(args, agents, st["llm_agents"], sim, llm, views, costs)

@@ -92,7 +92,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ignjax.agents.llm.agent import ASK, MOVE, MOVED_M, Decision, LLMAgent, compass_degrees
+from ignjax.agents.llm.agent import ASK, Decision, LLMAgent, compass_degrees
 from ignjax.agents.llm.cache import ResponseCache
 from ignjax.agents.llm.client import ChatClient, ChatRequest, ImagePart, LLMRequestError
 from ignjax.agents.llm.config import LLMConfig
@@ -101,7 +101,11 @@ from ignjax.errors import ConfigError
 from ignjax.evaluate import accounting as A
 from ignjax.evaluate import candidates as C
 from ignjax.evaluate.accounting import ACCOUNTING
+from ignjax.evaluate import records as R
+from ignjax.evaluate.context import DecisionContext
+from ignjax.evaluate.records import LoopResult
 from ignjax.evaluate.recovery import ProgressLog
+from ignjax.evaluate.textobs import last_move_text, observation_text
 from ignjax.fileio import atomic_write
 from ignjax.protocol import LOCKED_COSTS
 from ignjax.scenes import vocab
@@ -126,26 +130,15 @@ class _Episode:
 
 
 @dataclass
-class LoopResult:
-    """What :func:`run_llm_agent` returns (episodes in file order).
+class _Run:
+    """The state of one :meth:`HostLoop.run`: episodes still queued (popped from the end), the episode in each
+    row, each running episode's trajectory rows, the finished episodes' records, and the decisions applied."""
 
-    Attributes:
-        outcomes: :class:`~ignjax.sim.types.OutcomeRow` of numpy arrays (E,).
-        trajectories: :class:`~ignjax.sim.types.Trajectory` of numpy arrays (E, ...).
-        accounting: column name -> (E,) array (:data:`ACCOUNTING`), plus ``failure`` (list of str).
-        stats: this run's totals: wall time, decisions, utilisation, ``requests`` (HTTP attempts sent in this
-            run) and ``retries``, requests in flight, ``resumed`` (episodes kept from an earlier run), ``rerun``
-            (episodes that had ended by a model failure, run again), ``failures`` (episodes that ended by one now),
-            ``paraphrased`` (paraphrase calls) and ``paraphrase_rejected``.
-        transcripts: the transcript records (viewer schema plus request hash,
-            image hashes, tokens, latency, cache hit), sorted by episode and step.
-    """
-
-    outcomes: T.OutcomeRow
-    trajectories: T.Trajectory
-    accounting: dict
-    stats: dict
-    transcripts: list
+    queue: list
+    slots: list
+    traj_rows: dict = field(default_factory=dict)
+    records: dict = field(default_factory=dict)
+    decisions: int = 0
 
 
 def _settings_hash(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, sim: T.SimConfig, views: ViewConfig, seed: int,
@@ -156,43 +149,6 @@ def _settings_hash(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, sim: T.SimCo
                        "sim": sim.to_dict(), "views": dataclasses.asdict(views.replace(workers=1)), "seed": seed,
                        "costs": [float(c) for c in costs]}, sort_keys=True, default=str)
     return hashlib.sha256(blob.encode()).hexdigest()[:16]
-
-
-def observation_text(obs: dict, r: int, categories: tuple[str, ...], names: tuple[str, ...], cells=None) -> str:
-    """Row ``r`` of the symbolic observation as text (the ``text`` observation of MLLM agents, an ablation:
-    ground truth, instance ids, metres and the room label included): per view, the free distance ahead and the
-    objects in sight with their perceived attributes; with ``cells`` (K, 2)
-    (:func:`ignjax.evaluate.candidates.front_cells`), the front-view grid cell of each object that appears in the
-    front view (what a Type-4 question names)."""
-    lines = []
-    fs = obs["free_space"][r]
-    handles, cats, views, ranges, attrs = (obs[k][r] for k in ("visible_handle", "visible_category", "visible_view",
-                                                                "visible_range", "visible_attrs"))
-    for k in range(fs.shape[0]):
-        seen = []
-        for j in np.flatnonzero((handles >= 0) & (views == k)):
-            words = [vocab.attribute_word(a, int(attrs[j, a])) for a in range(4) if attrs[j, a] >= 0]
-            words = [w for w in words if w]
-            cat = vocab.category_display(categories[int(cats[j])]) if 0 <= cats[j] < len(categories) else "object"
-            where = (f", front view column {int(cells[j, 0])} row {int(cells[j, 1])}"
-                     if cells is not None and cells[j, 0] > 0 else "")
-            seen.append(f"{' '.join(words + [cat])} (object {int(handles[j])}, about {float(ranges[j]):.1f} m{where})")
-        name = names[k] if k < len(names) else f"view {k}"
-        lines.append(f"- {name}: open floor for about {float(fs[k].min()):.1f} m; "
-                     + (f"you see {', '.join(seen)}" if seen else "nothing of note"))
-    room = int(obs["room_label"][r])
-    if 0 <= room < len(vocab.ALL_ROOM_LABELS):
-        lines.insert(0, f"You seem to be in a {vocab.ROOM_DISPLAY[vocab.ALL_ROOM_LABELS[room]]}.")
-    return "\n".join(lines)
-
-
-def _last_move_text(obs: dict, r: int, kind: int) -> str:
-    if kind != MOVE:
-        return ""
-    moved = float(obs["last_move"][r])
-    if moved < MOVED_M:
-        return "the way was blocked; you did not move."
-    return f"you moved {moved:.1f} m" + ("; part of the way was blocked." if obs["blocked"][r].any() else ".")
 
 
 # The loop's jitted pieces take the world as an argument (its configuration is
@@ -231,65 +187,6 @@ def _observe_rows(world, states):
 @jax.jit
 def _outcome_rows(world, states):
     return jax.vmap(lambda s: E.outcome(world, s))(states)
-
-
-class _Context:
-    """What an agent's :meth:`~ignjax.agents.llm.agent.LLMAgent.decide` may
-    use for one decision: model calls with re-asks (:meth:`query`, counted
-    in the episode's accounting and transcript) and the image of a view (:meth:`view_image`)."""
-
-    def __init__(self, loop: "HostLoop", client: ChatClient, ep: _Episode, d: Decision):
-        self._loop, self._client, self._ep, self._d = loop, client, ep, d
-        self.defaulted = False
-        self.question = ""
-        self.rule: tuple[str, str] | None = None
-
-    def note_question(self, text: str) -> None:
-        """Record the text of the question this decision asks (agents that
-        write their questions): the decision's transcript record carries it
-        as ``question``. The oracle answers by type; the text is a record."""
-        self.question = str(text)
-
-    def note_rule(self, rule: str, text: str) -> None:
-        """Record that the agent's controller decided (or changed) this decision by ``rule``, and what it did in
-        words (``text``): the decision's transcript record carries both."""
-        self.rule = (str(rule), str(text))
-
-    async def query(self, request, parse, role: str = "planner", reasks: int | None = None):
-        """Send ``request``; ``parse(parsed, parse_error) -> (value, error)``
-        turns a reply into a value or an error, an error is answered with the
-        agent's correction and asked again (``reasks``, default the agent's).
-        Returns the value, or None when every reply was unusable.
-
-        Raises:
-            LLMRequestError: the request kept failing (the episode ends with
-                stop reason ``model_failure``).
-        """
-        n = self._loop.agent.reasks if reasks is None else int(reasks)
-        return await self._loop._query(self._client, self._ep, self._d, request, parse, role, n)
-
-    def view_image(self, k: int, grid: bool = True) -> ImagePart:
-        """View ``k`` of this decision, encoded: with the numbered 8x8 grid (the Grounder's image, kept with the
-        episode's saved images), or without it (``grid=False``: the captioner's image, not kept)."""
-        from ignjax.sim.views.compose import grounder_images
-        from ignjax.sim.views.encode import encode_images
-
-        rgb = self._d.views
-        if rgb is None:
-            raise ValueError("this decision carries no rendered views")
-        if not 0 <= int(k) < rgb.shape[0]:
-            raise ValueError(f"view {k} is outside the {rgb.shape[0]} views")
-        fmt, one = self._loop.views.image_format, rgb[int(k)][None]
-        data = encode_images(grounder_images(one) if grid else one, fmt, self._loop.views.quality)[0]
-        img = ImagePart(data, "image/jpeg" if fmt == "jpeg" else "image/png")
-        if grid and self._ep.index < self._loop.save_images:
-            self._ep.images.append((self._d.step, img, "grounder"))
-        return img
-
-    def default(self, action):
-        """Mark this decision's action as the default after unusable replies (returns ``action``)."""
-        self.defaulted = True
-        return action
 
 
 class HostLoop:
@@ -369,7 +266,7 @@ class HostLoop:
                 episode=rec["episode_id"], step=int(step[r]), max_steps=self.sim.max_steps,
                 goal=vocab.category_display(rec["target_category"]), questions_left=int(qleft[r]),
                 costs=self.costs, answers=tuple(ep.answers),
-                last_move=_last_move_text(obs, r, last_kind), hint_report=ep.progress,
+                last_move=last_move_text(obs, r, last_kind), hint_report=ep.progress,
                 n_views=self.sim.n_views, view_fov=self.sim.view_hfov, observation=text, percept=percept,
                 heading=compass_degrees(pose[r][2]), offset=tuple(float(v) for v in obs["odometry"][r][:2]))})
         return out
@@ -401,10 +298,10 @@ class HostLoop:
 
     async def _decide(self, client: ChatClient, ep: _Episode, d: Decision):
         """One decision (the agent's :meth:`~ignjax.agents.llm.agent.LLMAgent.decide`
-        with a :class:`_Context`): ``("act", tuple)`` or ``("fail", reason)``."""
+        with a :class:`~ignjax.evaluate.context.DecisionContext`): ``("act", tuple)`` or ``("fail", reason)``."""
         try:
             d = await self._paraphrase(client, ep, d)
-            ctx = _Context(self, client, ep, d)
+            ctx = DecisionContext(self, client, ep, d)
             first = len(ep.calls)
             act = tuple(int(x) for x in await self.agent.decide(ctx, ep.memory, d))
         except LLMRequestError as e:
@@ -512,75 +409,118 @@ class HostLoop:
             ep.unread.append(len(ep.answers) - 1)
 
     # -- the loop -------------------------------------------------------------
+    def _progress_bar(self, done: int):
+        if not self.progress:
+            return None
+        import sys
+
+        from tqdm.auto import tqdm
+
+        return tqdm(total=self.n, initial=done, desc=self.agent.name, unit="ep", file=sys.stderr, dynamic_ncols=True)
+
+    def _fill(self, run: _Run, states, free_rows):
+        """Start the next queued episodes in ``free_rows``: ``(states, the rows started)``."""
+        rows, idx = [], []
+        for r in free_rows:
+            if not run.queue:
+                break
+            i = run.queue.pop()
+            ep = run.slots[r] = _Episode(i, self.agent.start(self.es.records[i]["episode_id"]))
+            if self.sim.upfront_description:  # given at reset (and charged) as one Type-1 and one Type-2 answer
+                o = self.es.records[i]["oracle"]
+                ep.answers = [(1, o["appearance"]), (2, o["region"])]
+                ep.unread = [0, 1] if self.llm.paraphrase else []
+            run.traj_rows[i] = []
+            rows.append(r)
+            idx.append(i)
+        if not rows:
+            return states, []
+        take = np.zeros(self.B, np.int64)
+        take[rows] = idx
+        mask = np.zeros(self.B, bool)
+        mask[rows] = True
+        specs = jax.tree.map(lambda a: a[take], self.es.specs)
+        return self._reset(specs, self.keys[take], jnp.asarray(mask), states), rows
+
+    def _note_step(self, run: _Run, acts, cand, step_mask, before_step, rec, pose, answers) -> None:
+        """Each stepped row's trajectory record, the oracle's answer in words and the active hint's report."""
+        for r in np.flatnonzero(step_mask):
+            ep = run.slots[r]
+            run.traj_rows[ep.index].append((int(before_step[r]), pose[r], [x[r] for x in rec]))
+            if acts[r, 0] == ASK:
+                self._answer(ep, int(acts[r, 4]), answers, r, int(before_step[r]), pointed=int(cand[r]) != T.NO_CANDIDATE)
+            ep.progress = OT.hint_report_text(int(answers.hint_progress[r]), int(answers.hint_bearing[r])) \
+                if answers.hint_active[r] else ""
+
+    def _retire(self, run: _Run, ended, outs, pose, log: ProgressLog, bar, client: ChatClient) -> None:
+        """Record the episodes of rows ``ended`` (progress file, images) and free their slots."""
+        for r in ended:
+            ep = run.slots[r]
+            entry = self._entry(ep, outs, r, run.traj_rows.pop(ep.index), pose[r])
+            run.records[ep.index] = entry
+            log.append(entry)
+            self._write_images(ep)
+            run.slots[r] = None
+            if bar:
+                st = client.stats()
+                bar.set_postfix_str(f"in flight {st.in_flight}, tok {st.prompt_tokens + st.completion_tokens}, "
+                                    f"retries {st.retries}", refresh=False)
+                bar.update(1)
+
+    async def _round(self, run: _Run, client: ChatClient, states, ready: dict, log: ProgressLog, bar):
+        """Apply one round of replies ``ready``: step the rows, record what happened, retire the episodes that
+        ended and start queued ones in their rows. Returns ``(states, the rows that need a decision)``."""
+        loop = asyncio.get_running_loop()
+        action, acts, cand, step_mask, fail_mask = self._actions(ready, run.slots)
+        run.decisions += int(step_mask.sum())
+        before_step = await loop.run_in_executor(None, np.asarray, states.step)
+        states, rec = await loop.run_in_executor(None, self._step, states, action, jnp.asarray(step_mask))
+        if fail_mask.any():
+            states = await loop.run_in_executor(None, self._abort, states, jnp.asarray(fail_mask))
+        rec, pose, done_now, answers = await loop.run_in_executor(None, lambda st=states, rc=rec: (
+            [np.asarray(x) for x in rc], np.asarray(st.pose), np.asarray(st.done), jax.tree.map(np.asarray, st.answers)))
+        self._note_step(run, acts, cand, step_mask, before_step, rec, pose, answers)
+        ended = [int(r) for r in np.flatnonzero((step_mask | fail_mask) & done_now)]
+        refilled = []
+        if ended:
+            outs = await loop.run_in_executor(None, lambda st=states: jax.tree.map(np.asarray, self._outcome(st)))
+            self._retire(run, ended, outs, pose, log, bar, client)
+            states, refilled = await loop.run_in_executor(None, self._fill, run, states, ended)
+        return states, sorted({int(r) for r in np.flatnonzero(step_mask & ~done_now)} | set(refilled))
+
     async def run(self) -> LoopResult:
         key = _settings_hash(self.es, self.agent, self.llm, self.sim, self.views, self.seed, self.costs)
         log = ProgressLog(None if self.out is None else self.out / "llm" / f"{self.agent.name}.progress.jsonl", key,
                           self.agent.name, self.n)
         finished, failed_before = log.load()
         log.open()
-        queue = [i for i in range(self.n) if i not in finished]
-        queue.reverse()
-        B, specs_all = self.B, self.es.specs
+        B = self.B
+        run = _Run(queue=[i for i in reversed(range(self.n)) if i not in finished], slots=[None] * B)
         # every slot starts empty: a padding episode (valid False) is done at reset
-        pad = jax.tree.map(lambda a: a[np.zeros(B, np.int64)], specs_all)
+        pad = jax.tree.map(lambda a: a[np.zeros(B, np.int64)], self.es.specs)
         pad = dataclasses.replace(pad, valid=jnp.zeros(B, bool))
         states = self._reset_all(pad, self.keys[np.zeros(B, np.int64)])
-        slots: list[_Episode | None] = [None] * B
-        records: dict[int, dict] = {}
-        traj_rows: dict[int, list] = {}
         t_start = time.perf_counter()
-        decisions = 0
-        bar = None
-        if self.progress:
-            from tqdm.auto import tqdm
-            import sys
-
-            bar = tqdm(total=self.n, initial=len(finished), desc=self.agent.name, unit="ep", file=sys.stderr,
-                       dynamic_ncols=True)
-
-        def fill(states, free_rows):
-            rows, idx = [], []
-            for r in free_rows:
-                if not queue:
-                    break
-                i = queue.pop()
-                slots[r] = _Episode(i, self.agent.start(self.es.records[i]["episode_id"]))
-                if self.sim.upfront_description:  # given at reset (and charged) as one Type-1 and one Type-2 answer
-                    o = self.es.records[i]["oracle"]
-                    slots[r].answers = [(1, o["appearance"]), (2, o["region"])]
-                    slots[r].unread = [0, 1] if self.llm.paraphrase else []
-                traj_rows[i] = []
-                rows.append(r)
-                idx.append(i)
-            if not rows:
-                return states, []
-            take = np.zeros(B, np.int64)
-            take[rows] = idx
-            mask = np.zeros(B, bool)
-            mask[rows] = True
-            specs = jax.tree.map(lambda a: a[take], specs_all)
-            return self._reset(specs, self.keys[take], jnp.asarray(mask), states), rows
-
+        bar = self._progress_bar(len(finished))
         cache = ResponseCache(self.llm.cache_dir) if self.llm.cache_dir else None
         loop = asyncio.get_running_loop()
         try:
             async with ChatClient(self.llm, cache=cache) as client:
                 t_stats0 = client.stats()
-                states, need = fill(states, list(range(B)))
+                states, need = self._fill(run, states, list(range(B)))
                 tasks: dict = {}
                 waiting: list[dict] = []  # rows prepared for a decision, not yet rendered
                 render = None  # the one render in progress (its rows' panels), or None
                 while True:
                     if need:
-                        rows = sorted(need)
-                        waiting += await loop.run_in_executor(None, lambda st=states, rs=rows: self._prepare(
-                            rs, slots, st, jax.tree.map(np.asarray, dataclasses.asdict(self._observe(st)))))
+                        waiting += await loop.run_in_executor(None, lambda st=states, rs=need: self._prepare(
+                            rs, run.slots, st, jax.tree.map(np.asarray, dataclasses.asdict(self._observe(st)))))
                         need = []
                     if waiting and render is None:
                         # rendered while the loop keeps stepping rows whose replies arrive; rows that become
                         # ready meanwhile are rendered together in the next call (at most render_rows a call,
                         # oldest first, so the first requests leave while the rest render)
-                        render = loop.run_in_executor(None, self._decisions, waiting[:self.render_rows], slots)
+                        render = loop.run_in_executor(None, self._decisions, waiting[:self.render_rows], run.slots)
                         waiting = waiting[self.render_rows:]
                     if not tasks and render is None:
                         break
@@ -588,47 +528,11 @@ class HostLoop:
                                                  return_when=asyncio.FIRST_COMPLETED)
                     if render in done:
                         for r, d in render.result():
-                            tasks[asyncio.ensure_future(self._decide(client, slots[r], d))] = r
+                            tasks[asyncio.ensure_future(self._decide(client, run.slots[r], d))] = r
                         render = None
                     ready = {tasks.pop(t): t.result() for t in done if t in tasks}
-                    if not ready:
-                        continue
-                    action, acts, cand, step_mask, fail_mask = self._actions(ready, slots)
-                    decisions += int(step_mask.sum())
-                    before_step = await loop.run_in_executor(None, np.asarray, states.step)
-                    states, rec = await loop.run_in_executor(None, self._step, states, action, jnp.asarray(step_mask))
-                    if fail_mask.any():
-                        states = await loop.run_in_executor(None, self._abort, states, jnp.asarray(fail_mask))
-                    rec, pose, done_now, answers = await loop.run_in_executor(None, lambda st=states, rc=rec: (
-                        [np.asarray(x) for x in rc], np.asarray(st.pose), np.asarray(st.done),
-                        jax.tree.map(np.asarray, st.answers)))
-                    for r in np.flatnonzero(step_mask):
-                        ep = slots[r]
-                        traj_rows[ep.index].append((int(before_step[r]), pose[r], [x[r] for x in rec]))
-                        if acts[r, 0] == ASK:
-                            self._answer(ep, int(acts[r, 4]), answers, r, int(before_step[r]),
-                                         pointed=int(cand[r]) != T.NO_CANDIDATE)
-                        ep.progress = OT.hint_report_text(int(answers.hint_progress[r]), int(answers.hint_bearing[r])) \
-                            if answers.hint_active[r] else ""
-                    ended = [r for r in np.flatnonzero((step_mask | fail_mask) & done_now)]
-                    if ended:
-                        outs = await loop.run_in_executor(None, lambda st=states: jax.tree.map(np.asarray, self._outcome(st)))
-                        for r in ended:
-                            ep = slots[r]
-                            entry = self._entry(ep, outs, r, traj_rows.pop(ep.index), pose[r])
-                            records[ep.index] = entry
-                            log.append(entry)
-                            self._write_images(ep)
-                            slots[r] = None
-                            if bar:
-                                st = client.stats()
-                                bar.set_postfix_str(f"in flight {st.in_flight}, tok {st.prompt_tokens + st.completion_tokens}, "
-                                                    f"retries {st.retries}", refresh=False)
-                                bar.update(1)
-                        states, refilled = await loop.run_in_executor(None, fill, states, ended)
-                    else:
-                        refilled = []
-                    need = sorted(set(r for r in np.flatnonzero(step_mask & ~done_now)) | set(refilled))
+                    if ready:
+                        states, need = await self._round(run, client, states, ready, log, bar)
                 stats = client.stats()
                 util = client.utilisation(t_stats0)
                 wall = time.perf_counter() - t_start
@@ -640,8 +544,8 @@ class HostLoop:
                 cache.close()
             if self.renderer is not None and self._own_renderer:
                 self.renderer.close()
-        records.update(finished)
-        return self._result(records, {"wall_s": wall, "decisions": decisions,
+        records = {**run.records, **finished}
+        return self._result(records, {"wall_s": wall, "decisions": run.decisions,
                                       "utilisation": util, "requests": stats.requests_sent,
                                       "retries": stats.retries, "max_in_flight": stats.max_in_flight,
                                       "resumed": len(finished), "rerun": len(failed_before),
@@ -661,56 +565,10 @@ class HostLoop:
             atomic_write(folder / f"{step:03d}_{role}.{ext}", img.data)
 
     def _entry(self, ep: _Episode, outs: dict, r: int, steps: list, final_pose) -> dict:
-        o = {k: np.asarray(getattr(outs, k))[r].tolist() for k in outs.__dataclass_fields__}
-        S = self.sim.max_steps
-        names = T.Trajectory.STEP_FIELDS
-        start = np.asarray(self.es.specs.start[ep.index], np.float32)
-        pose = np.repeat(np.asarray(final_pose, np.float32)[None], S + 1, 0)
-        pose[0] = start
-        cols = {}
-        steps.sort(key=lambda s: s[0])
-        last = len(steps)
-        if last:
-            pose[1:last + 1] = [p for _, p, _ in steps]
-            pose[last + 1:] = steps[-1][1]
-        for k, name in enumerate(names):
-            if steps:
-                vals = np.stack([rec[k] for _, _, rec in steps])
-                fill = np.repeat(vals[-1:], S - last, 0)
-                if name in ("kind", "direction", "col", "row", "candidate"):
-                    fill[:] = -1
-                elif name == "question":
-                    fill[:] = 0
-                elif name in ("blocked", "refused"):
-                    fill[:] = False
-                cols[name] = np.concatenate([vals, fill]).tolist()
-            else:
-                cols[name] = None
-        return {"index": ep.index, "episode_id": self.es.records[ep.index]["episode_id"], "outcome": o,
-                "trajectory": {"pose": pose.tolist(), **cols}, "accounting": dict(ep.acc), "failure": ep.failure,
-                "calls": ep.calls}
+        return R.episode_entry(self.es, self.sim, ep, outs, r, steps, final_pose)
 
     def _result(self, records: dict[int, dict], stats: dict) -> LoopResult:
-        order = [records[i] for i in range(self.n)]
-        first = next((r for r in order if r["trajectory"]["kind"] is not None), None)
-
-        def traj_field(name):
-            rows = []
-            for r in order:
-                v = r["trajectory"][name]
-                if v is None:  # an episode that never stepped (failed at its first decision)
-                    v = np.zeros_like(np.asarray(first["trajectory"][name])) if first else np.zeros((self.sim.max_steps,))
-                rows.append(np.asarray(v))
-            return np.stack(rows)
-
-        dtypes = {f.name: None for f in dataclasses.fields(T.OutcomeRow)}
-        outcomes = T.OutcomeRow(**{k: np.asarray([r["outcome"][k] for r in order]) for k in dtypes})
-        traj = T.Trajectory(pose=np.stack([np.asarray(r["trajectory"]["pose"], np.float32) for r in order]),
-                            **{k: traj_field(k) for k in T.Trajectory.STEP_FIELDS})
-        acc = {k: np.asarray([r["accounting"][k] for r in order]) for k in ACCOUNTING}
-        acc["failure"] = [r["failure"] for r in order]
-        calls = [c for r in order for c in r["calls"]]
-        return LoopResult(outcomes=outcomes, trajectories=traj, accounting=acc, stats=stats, transcripts=calls)
+        return R.loop_result([records[i] for i in range(self.n)], stats, self.sim)
 
 
 def run_llm_agent(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, *, sim: T.SimConfig = T.SimConfig(),

@@ -198,6 +198,13 @@ def test_requests_and_retries_count_attempts_without_a_response(tmp_path, episod
     assert res.outcomes.stop_reason.tolist() == [T.ABORTED] * N
     assert res.accounting["requests"].tolist() == [3] * N and res.accounting["retries"].tolist() == [2] * N
     assert res.stats["requests"] == received == 3 * N and res.stats["retries"] == 2 * N and res.stats["failures"] == N
+    # no episode stepped: their trajectories are those of episodes that ended before their first step
+    tr = res.trajectories
+    assert (tr.kind == -1).all() and (tr.question == 0).all() and (tr.candidate == -1).all()
+    assert tr.n_questions.shape == (N, SIM.max_steps, 4) and (tr.n_questions == 0).all()
+    assert tr.visible.shape == (N, SIM.max_steps, SIM.max_visible) and (tr.visible == -1).all()
+    assert tr.visible_attrs.shape == (N, SIM.max_steps, SIM.max_visible, 4) and tr.blocked.shape[2] == 8
+    np.testing.assert_allclose(tr.waypoint[:, 0], np.asarray(episodes.specs.start)[:, :2], atol=1e-5)
 
 
 def test_the_viewer_reads_the_grounder_images_the_run_writes(rendering, tmp_path):

@@ -91,74 +91,22 @@ from ignjax.agents.llm.agent import (ASK, MOVE, MOVED_M, QUESTION_HELP, QUESTION
                                      orientation_text)
 from ignjax.agents.llm.caption import describe_views
 from ignjax.agents.llm.client import ChatRequest
-from ignjax.agents.llm.controller import RECOVERY_MOVES, TEXT_CHARS, TandemController, TandemMemory, clip, rear
+from ignjax.agents.llm.controller import RECOVERY_MOVES, TandemController, TandemMemory, clip, rear
 from ignjax.agents.llm.counterfactual import PROMPT as COUNTERFACTUAL_PROMPT
 from ignjax.agents.llm.counterfactual import counterfactual_error, with_counterfactuals
 from ignjax.agents.llm.graph_memory import MERGE_M, graph_text
+from ignjax.agents.llm.schemas import (GROUNDER_SCHEMA, MEMORY_ITEMS, PHASES, one_stage_schema, parse_cell,
+                                       planner_schema)
 from ignjax.agents.llm.self_questioner import PROMPT as SELF_CHECK_PROMPT
 from ignjax.agents.llm.self_questioner import self_check
 from ignjax.sim import oracle_text as OT
 from ignjax.sim import types as T
 from ignjax.sim.views.compose import view_names
 
-PHASES = ("explore", "verify", "approach", "recover")
-MEMORY_ITEMS = 6
-"""Entries kept per Spatial Memory list."""
 GROUNDER_FALLBACK = (4, 2)
 """Cell taken when no Grounder reply is usable: centre column, near floor."""
 CANDIDATE_FALLBACK = (4, 4)
 """Candidate cell of a Type-4 question when no Grounder reply is usable: the front view's middle."""
-
-
-def planner_schema(names: tuple[str, ...], actions=("move", "ask", "stop"), questions=(1, 2, 3, 4)) -> dict:
-    """JSON schema of one Planner decision (every key required; the ones an
-    action does not use are ignored): ``actions`` the agent may take,
-    ``questions`` the types it may ask."""
-    s = {"type": "string", "maxLength": TEXT_CHARS}
-    lst = {"type": "array", "items": s, "maxItems": MEMORY_ITEMS}
-    return {
-        "type": "object",
-        "properties": {
-            "reasoning": {"type": "string", "maxLength": 400},
-            "task_phase": {"type": "string", "enum": list(PHASES)},
-            "belief_update": {
-                "type": "object",
-                "properties": {"current_room": s, "target_description": s, "visited_areas": lst,
-                               "unexplored_areas": lst, "key_observations": lst},
-                "required": ["current_room", "target_description", "visited_areas", "unexplored_areas",
-                             "key_observations"],
-                "additionalProperties": False,
-            },
-            "action": {"type": "string", "enum": list(actions)},
-            "direction": {"type": "string", "enum": list(names)},
-            "subgoal": s,
-            "purpose": s,
-            "question_type": {"type": "integer", "enum": list(questions)},
-            "question": s,
-        },
-        "required": ["reasoning", "task_phase", "belief_update", "action", "direction", "subgoal", "purpose",
-                     "question_type", "question"],
-        "additionalProperties": False,
-    }
-
-
-def one_stage_schema(names: tuple[str, ...], actions=("move", "ask", "stop"), questions=(1, 2, 3, 4)) -> dict:
-    """The Planner schema plus the grid cell (one-stage baselines pick it themselves)."""
-    s = planner_schema(names, actions, questions)
-    s["properties"].update({"col": {"type": "integer", "minimum": 1, "maximum": 8},
-                            "row": {"type": "integer", "minimum": 1, "maximum": 8}})
-    s["required"] = s["required"] + ["col", "row"]
-    return s
-
-
-GROUNDER_SCHEMA = {
-    "type": "object",
-    "properties": {"col": {"type": "integer", "minimum": 1, "maximum": 8},
-                   "row": {"type": "integer", "minimum": 1, "maximum": 8},
-                   "rationale": {"type": "string", "maxLength": 200}},
-    "required": ["col", "row", "rationale"],
-    "additionalProperties": False,
-}
 
 
 def hint_block(hint: str, progress: int, bearing: int) -> str:
@@ -174,17 +122,6 @@ def hint_block(hint: str, progress: int, bearing: int) -> str:
     if said := OT.hint_progress_text(progress):
         lines.append(f"Progress: {said}")
     return "\n".join(lines)
-
-
-def _cell(parsed, err):
-    """``((col, row), None)`` from a reply's grid cell, or ``(None, why)``."""
-    if parsed is None:
-        return None, err or "the reply is not a JSON object"
-    for key in ("col", "row"):
-        v = parsed.get(key)
-        if isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= 8:
-            return None, f"field '{key}' must be an integer from 1 to 8"
-    return (parsed["col"], parsed["row"]), None
 
 
 class Tandem(TandemController, LLMAgent):
@@ -534,7 +471,7 @@ class Tandem(TandemController, LLMAgent):
         if act is None:
             return None, why
         if not self.two_stage and (act[0] == MOVE or (act[0] == ASK and act[4] == 4)):
-            cell, why = _cell(parsed, None)
+            cell, why = parse_cell(parsed, None)
             if cell is None:
                 return None, why
             act = (MOVE, act[1], *cell, 1) if act[0] == MOVE else (ASK, 0, *cell, 4)
@@ -545,7 +482,7 @@ class Tandem(TandemController, LLMAgent):
             return act
         k = act[1]
         req = self.grounder_request(d, ctx.view_image(k), clip(parsed.get("subgoal")), clip(parsed.get("purpose")))
-        got = await ctx.query(req, _cell, role="grounder")
+        got = await ctx.query(req, parse_cell, role="grounder")
         col, row = got if got is not None else GROUNDER_FALLBACK
         return (MOVE, k, col, row, 1)
 
@@ -556,7 +493,7 @@ class Tandem(TandemController, LLMAgent):
         if not self.two_stage:
             return act
         what = clip(parsed.get("subgoal")) or clip(parsed.get("question")) or f"the {d.goal}"
-        got = await ctx.query(self.candidate_request(d, ctx.view_image(0), what), _cell, role="grounder")
+        got = await ctx.query(self.candidate_request(d, ctx.view_image(0), what), parse_cell, role="grounder")
         col, row = got if got is not None else CANDIDATE_FALLBACK
         return (ASK, 0, col, row, 4)
 
