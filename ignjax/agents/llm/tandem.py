@@ -98,7 +98,7 @@ from ignjax.agents.llm.graph_memory import MERGE_M, graph_text
 from ignjax.agents.llm.schemas import (GROUNDER_SCHEMA, MEMORY_ITEMS, PHASES, one_stage_schema, parse_cell,
                                        planner_schema)
 from ignjax.agents.llm.self_questioner import PROMPT as SELF_CHECK_PROMPT
-from ignjax.agents.llm.self_questioner import self_check
+from ignjax.agents.llm.self_questioner import candidate_of, self_check
 from ignjax.sim import oracle_text as OT
 from ignjax.sim import types as T
 from ignjax.sim.views.compose import view_names
@@ -492,7 +492,7 @@ class Tandem(TandemController, LLMAgent):
         agents named the cell themselves."""
         if not self.two_stage:
             return act
-        what = clip(parsed.get("subgoal")) or clip(parsed.get("question")) or f"the {d.goal}"
+        what = candidate_of(parsed, d)
         got = await ctx.query(self.candidate_request(d, ctx.view_image(0), what), parse_cell, role="grounder")
         col, row = got if got is not None else CANDIDATE_FALLBACK
         return (ASK, 0, col, row, 4)
