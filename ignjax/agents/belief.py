@@ -14,13 +14,20 @@ Answer models (likelihood of answer a under hypothesis h):
 * Type 1: a = the target's attributes (colour, material, size, state). A
   seen candidate answers the attributes it was seen with (uniformly when
   none was observed); "not seen" answers uniformly over the
-  ``N_ATTR_ANSWERS`` combinations. Folding a received answer: each said
-  attribute a candidate was seen with another value of costs it
+  ``N_ATTR_ANSWERS`` combinations. A received answer: each said attribute
+  a candidate was last seen with another value of costs it
   ``ATTR_MISMATCH_LOGLIK``; "not seen" pays ``-log(n)`` per said attribute
   with n values. Once the answer is known the question is worth 0.
 * Type 2: a = the goal room label (12 labels). A candidate answers the
-  room label the agent stood in when it saw it (uniform when unknown);
-  "not seen" answers uniformly. Worth 0 once known.
+  room label the agent stood in at its nearest sighting within 3 m
+  (uniform when unknown); "not seen" answers uniformly. Worth 0 once known.
+
+The Type-1 and Type-2 facts are kept in memory when received (asked, or
+given at reset with the upfront description) and their likelihood under a
+candidate is recomputed from what memory holds about it at every decision
+(:func:`~ignjax.agents.memory.fact_loglik`): a candidate's room label can
+improve after its first sighting (a view through a doorway, then one from
+inside), and the evidence follows it.
 * Type 3: a = the sector (8) of the route's way out. A candidate answers
   the sector of its bearing with probability 0.6 and each neighbouring
   sector with 0.2 (routes bend); "not seen" answers uniformly.
@@ -46,7 +53,7 @@ import jax
 import jax.numpy as jnp
 
 from ignjax.agents.memory import (
-    N_ROOM_LABELS, ROOM_MISMATCH_LOGLIK, Memory, attribute_loglik, candidate_relative, observe_memory,
+    N_ROOM_LABELS, Memory, candidate_relative, fact_loglik, observe_memory,
 )
 from ignjax.arrays import pytree_dataclass
 from ignjax.protocol import CONFIRM_RANGE, LOCKED_COSTS
@@ -150,8 +157,10 @@ def _sector_likelihood(answer, sectors):
 def _fold_answers(mem: Memory, obs: T.Observation, answers: T.Answer, hint_stop=False) -> Memory:
     """Fold the answers into the belief: the Type-1 and Type-2 facts once,
     when they first become known (asked, or given at reset with the upfront
-    description); the answer to last step's Type-3 or Type-4 question; with
-    ``hint_stop``, the active hint's progress report after last step's MOVE."""
+    description): into the unseen hypotheses, and kept in ``mem.facts`` for
+    the candidates (:func:`belief` weighs them by what memory holds now);
+    the answer to last step's Type-3 or Type-4 question; with ``hint_stop``,
+    the active hint's progress report after last step's MOVE."""
     q = mem.last_asked
     fresh = (q > 0) & ~answers.refused & (answers.last_type == q)
     new1 = answers.known[0] & ~mem.consumed[0]
@@ -159,13 +168,10 @@ def _fold_answers(mem: Memory, obs: T.Observation, answers: T.Answer, hint_stop=
     M = mem.handle.shape[0]
     labels = jnp.arange(N_ROOM_LABELS)[:, None]
     rel = _abs_sector(obs)[None, :]
-    # Type 1: attributes
+    # Type 1: attributes (the candidates' side: fact_loglik on mem.facts)
     said = said_attributes(answers)
-    d1 = attribute_loglik(mem.attrs, said)
     u1 = jnp.full((N_ROOM_LABELS, 8), -jnp.sum(jnp.where(said >= 0, jnp.log(jnp.asarray(ATTR_VALUES, jnp.float32)), 0.0)))
-    # Type 2: room label
-    room_bad = (mem.room >= 0) & (mem.room != answers.room_label) & (answers.room_label >= 0)
-    d2 = jnp.where(room_bad, ROOM_MISMATCH_LOGLIK, 0.0)
+    # Type 2: room label (likewise)
     u2 = jnp.where((answers.room_label >= 0) & (labels != answers.room_label), -30.0, 0.0) * jnp.ones((1, 8))
     # Type 3: route sector (relative at asking time = now)
     _, bearing = candidate_relative(mem, obs)
@@ -184,7 +190,8 @@ def _fold_answers(mem: Memory, obs: T.Observation, answers: T.Answer, hint_stop=
     moved = (q == 0) & (mem.t > 0) & answers.hint_active & (answers.hint_progress != T.HINT_NONE)
     rej_hint = hint_stop & moved & (answers.hint_progress != T.HINT_STOP) & (mem.handle >= 0) & (dist <= HINT_REJECT_RANGE)
     f3, f4 = fresh & (q == 3), fresh & (q == 4)
-    d = jnp.where(new1, d1, 0.0) + jnp.where(new2, d2, 0.0) + jnp.where(f3, d3, 0.0) + jnp.where(f4, d4, 0.0)
+    d = jnp.where(f3, d3, 0.0) + jnp.where(f4, d4, 0.0)
+    facts = jnp.concatenate([jnp.where(new1, said, mem.facts[:4]), jnp.where(new2, answers.room_label, mem.facts[4:])])
     u = jnp.where(new1, u1, 0.0) + jnp.where(new2, u2, 0.0) + jnp.where(f3, u3, 0.0) + jnp.where(f4, u4, 0.0)
     return dataclasses.replace(
         mem,
@@ -195,6 +202,7 @@ def _fold_answers(mem: Memory, obs: T.Observation, answers: T.Answer, hint_stop=
         has_hint=mem.has_hint | f3,
         hint_done=(mem.hint_done | (answers.hint_progress == T.HINT_REACHED)) & ~f3,
         consumed=mem.consumed | jnp.stack([new1, new2, f3, f4]),
+        facts=facts.astype(jnp.int32),
     )
 
 
@@ -203,7 +211,7 @@ def belief(mem: Memory, params: BeliefParams):
     (L * 8,) "not seen yet, room label l, absolute sector s" (row-major)."""
     valid = (mem.handle >= 0) & ~mem.rejected
     n_seen = jnp.sum(valid)
-    lw = jnp.where(valid, mem.logw, -jnp.inf)
+    lw = jnp.where(valid, mem.logw + fact_loglik(mem), -jnp.inf)
     n_unseen = N_ROOM_LABELS * 8
     lu = jnp.log(jnp.maximum(params.prior_count - n_seen, 0.25)) - math.log(n_unseen) + mem.unseen_logw.reshape(-1)
     logits = jnp.concatenate([lw, lu])
@@ -316,8 +324,7 @@ def update_belief(params: BeliefParams, obs: T.Observation, answers: T.Answer, m
         (memory, belief): the updated memory and :func:`belief` on it.
     """
     mem = _fold_answers(mem, obs, answers, params.hint_stop)
-    mem = observe_memory(mem, obs, jnp.where(answers.known[0], said_attributes(answers), -1),
-                         jnp.where(answers.known[1], answers.room_label, -1))
+    mem = observe_memory(mem, obs)
     return mem, belief(mem, params)
 
 

@@ -5,8 +5,14 @@ observation is folded into it.
   ``VISIT_CELL`` metres per cell) to prefer unexplored directions;
 * candidate slots: every instance of the instruction's category the agent
   has seen (handle, estimated position from range and bearing, attributes,
-  the room label the agent stood in when it saw it, log-likelihood of the
-  oracle's answers, rejected by a Type-4 "no");
+  the room label the agent stood in at its nearest sighting within 3 m and
+  every label it stood in at a sighting within 3 m, log-likelihood of the oracle's route and confirmation answers, rejected
+  by a Type-4 "no");
+* the Type-1 and Type-2 facts received (the description's attributes, the
+  goal room label): their likelihood under a candidate is taken from what
+  memory holds about it now (:func:`fact_loglik`), so a candidate first
+  seen through a doorway from the next room and later from inside its own
+  is judged by both sightings;
 * the belief state of the belief-based agents (:mod:`ignjax.agents.belief`):
   the "not seen yet" log-likelihoods, the last route hint, the pending
   question.
@@ -45,8 +51,13 @@ class Memory:
         handle: (M,) int32 instance handle of each candidate slot (-1 empty).
         pos: (M, 2) float32 estimated candidate positions, odometry frame.
         attrs: (M, 4) int32 observed colour/material/size/state codes.
-        room: (M,) int32 room label the agent stood in when it saw the candidate (-1 unknown).
-        logw: (M,) float32 log-likelihood of the oracle's answers under "this candidate is the target".
+        room: (M,) int32 room label the agent stood in at its nearest sighting of the candidate
+            within 3 m (-1 unknown): a nearer sighting replaces the label of a farther one.
+        room_range: (M,) float32 range of that sighting (inf: none).
+        room_seen: (M,) int32 bit l set when the agent saw the candidate within 3 m
+            while standing in a room of label l.
+        logw: (M,) float32 log-likelihood of the Type-3 and Type-4 answers under "this candidate is
+            the target" (the Type-1 and Type-2 facts enter through :func:`fact_loglik`).
         rejected: (M,) bool, a Type-4 answer said no.
         unseen_logw: (L, 8) float32 the same for "the target is an instance not
             seen yet, in a room with label l, in absolute direction sector s
@@ -62,6 +73,8 @@ class Memory:
         t: () int32 decisions taken.
         consumed: (4,) bool, answers of each type already folded into the
             belief (Type 1 and 2 facts are folded once).
+        facts: (5,) int32 the Type-1 attributes said (colour, material, size,
+            state) and the Type-2 goal room label, -1 unsaid or not known yet.
     """
 
     visits: jax.Array
@@ -69,6 +82,8 @@ class Memory:
     pos: jax.Array
     attrs: jax.Array
     room: jax.Array
+    room_range: jax.Array
+    room_seen: jax.Array
     logw: jax.Array
     rejected: jax.Array
     unseen_logw: jax.Array
@@ -81,18 +96,20 @@ class Memory:
     pending_stop: jax.Array
     t: jax.Array
     consumed: jax.Array
+    facts: jax.Array
 
     @staticmethod
     def empty() -> "Memory":
         M = MAX_CANDIDATES
         return Memory(visits=jnp.zeros((VISIT_SIZE, VISIT_SIZE), VISIT_DTYPE), handle=jnp.full(M, -1, jnp.int32),
                       pos=jnp.zeros((M, 2), jnp.float32), attrs=jnp.full((M, 4), -1, jnp.int32),
-                      room=jnp.full(M, -1, jnp.int32), logw=jnp.zeros(M, jnp.float32), rejected=jnp.zeros(M, bool),
+                      room=jnp.full(M, -1, jnp.int32), room_range=jnp.full(M, jnp.inf, jnp.float32),
+                      room_seen=jnp.zeros(M, jnp.int32), logw=jnp.zeros(M, jnp.float32), rejected=jnp.zeros(M, bool),
                       unseen_logw=jnp.zeros((N_ROOM_LABELS, 8), jnp.float32), hint_heading=jnp.float32(0.0),
                       has_hint=jnp.array(False), hint_done=jnp.array(False), last_asked=jnp.int32(0),
                       asked_about=jnp.int32(-1),
                       approach=jnp.int32(-1), pending_stop=jnp.array(False), t=jnp.int32(0),
-                      consumed=jnp.zeros(4, bool))
+                      consumed=jnp.zeros(4, bool), facts=jnp.full(5, -1, jnp.int32))
 
 
 def visit_index(xy):
@@ -111,17 +128,30 @@ def attribute_loglik(attrs, said):
     return ATTR_MISMATCH_LOGLIK * jnp.sum(bad, axis=-1).astype(jnp.float32)
 
 
-def observe_memory(mem: Memory, obs: T.Observation, attrs_known=None, room_known=None) -> Memory:
+def fact_loglik(mem: Memory):
+    """(M,) log-likelihood of the Type-1 and Type-2 facts known (``mem.facts``)
+    under "this candidate is the target", from the attributes it was last seen
+    with (:func:`attribute_loglik`) and the room labels the agent stood in
+    when it saw it within 3 m: :data:`ROOM_MISMATCH_LOGLIK` when it was seen
+    so but never from a room with the goal label. Recomputed from memory at
+    every decision rather than fixed at the first sighting: an object seen
+    through a doorway from the next room, or from a room open to its own,
+    is cleared by a sighting from inside a room with the goal label."""
+    goal = mem.facts[4]
+    from_goal = (jnp.right_shift(mem.room_seen, jnp.maximum(goal, 0)) & 1) == 1
+    room_bad = (goal >= 0) & (mem.room_seen != 0) & ~from_goal
+    return attribute_loglik(mem.attrs, mem.facts[:4]) + jnp.where(room_bad, ROOM_MISMATCH_LOGLIK, 0.0)
+
+
+def observe_memory(mem: Memory, obs: T.Observation) -> Memory:
     """Fold an observation into memory: mark the visit, add/refresh the
-    candidates of the goal category in sight. New candidates start with
-    the log-likelihood of the Type-1 attributes and Type-2 room answers
-    already received (``attrs_known``: (4,) int32 said colour, material,
-    size and state codes, -1 unsaid; ``room_known``: () int32 code or -1)."""
+    candidates of the goal category in sight (position and attributes from
+    the latest sighting; the room label the agent stands in, among the
+    labels it was seen from when within 3 m, and as its label when this
+    is the nearest such sighting so far)."""
     ij = visit_index(obs.odometry[:2])
     v = mem.visits[ij[1], ij[0]]
     visits = mem.visits.at[ij[1], ij[0]].set(jnp.where(v < jnp.iinfo(v.dtype).max, v + 1, v))
-    attrs_known = jnp.full(4, -1, jnp.int32) if attrs_known is None else jnp.asarray(attrs_known, jnp.int32)
-    room_known = jnp.int32(-1) if room_known is None else room_known
 
     def add(k, m: Memory):
         h = obs.visible_handle[k]
@@ -135,16 +165,20 @@ def observe_memory(mem: Memory, obs: T.Observation, attrs_known=None, room_known
         slot = jnp.where(exists, jnp.argmax(match), jnp.argmax(free))
         can = ok & (exists | jnp.any(free))
         new = ok & ~exists & jnp.any(free)
-        room = jnp.where(obs.visible_range[k] <= 3.0, obs.room_label, -1)
-        lw = attribute_loglik(obs.visible_attrs[k], attrs_known) \
-            + jnp.where((room_known >= 0) & (room >= 0) & (room != room_known), ROOM_MISMATCH_LOGLIK, 0.0)
+        r = obs.visible_range[k]
+        near = can & (r <= 3.0) & (obs.room_label >= 0)
+        nearer = near & (new | (r < m.room_range[slot]))
+        bit = jnp.left_shift(jnp.int32(1), jnp.maximum(obs.room_label, 0))
+        seen_from = jnp.where(new, 0, m.room_seen[slot]) | jnp.where(near, bit, 0)
         return dataclasses.replace(
             m,
             handle=m.handle.at[slot].set(jnp.where(can, h, m.handle[slot])),
             pos=m.pos.at[slot].set(jnp.where(can, p, m.pos[slot])),
             attrs=m.attrs.at[slot].set(jnp.where(can, obs.visible_attrs[k], m.attrs[slot])),
-            room=m.room.at[slot].set(jnp.where(new, room, jnp.where(can & (m.room[slot] < 0), room, m.room[slot]))),
-            logw=m.logw.at[slot].set(jnp.where(new, lw, m.logw[slot])),
+            room=m.room.at[slot].set(jnp.where(nearer, obs.room_label, jnp.where(new, -1, m.room[slot]))),
+            room_range=m.room_range.at[slot].set(jnp.where(nearer, r, jnp.where(new, jnp.inf, m.room_range[slot]))),
+            room_seen=m.room_seen.at[slot].set(jnp.where(can, seen_from, m.room_seen[slot])),
+            logw=m.logw.at[slot].set(jnp.where(new, 0.0, m.logw[slot])),
         )
 
     mem = dataclasses.replace(mem, visits=visits)
@@ -160,4 +194,5 @@ def candidate_relative(mem: Memory, obs: T.Observation):
 
 
 __all__ = ["ATTR_MISMATCH_LOGLIK", "MAX_CANDIDATES", "Memory", "N_ROOM_LABELS", "ROOM_MISMATCH_LOGLIK", "VISIT_CELL",
-           "VISIT_DTYPE", "VISIT_SIZE", "attribute_loglik", "candidate_relative", "observe_memory", "visit_index"]
+           "VISIT_DTYPE", "VISIT_SIZE", "attribute_loglik", "candidate_relative", "fact_loglik", "observe_memory",
+           "visit_index"]
