@@ -27,8 +27,10 @@ from __future__ import annotations
 
 import math
 
+import jax.numpy as jnp
 import numpy as np
 
+from ignjax.sim import geometry as G
 from ignjax.sim import types as T
 
 
@@ -71,15 +73,14 @@ def front_cells(cfg: T.SimConfig, pose, centers: np.ndarray) -> np.ndarray:
     ``cfg.eye_height``, level, ``cfg.view_hfov`` wide."""
     centers = np.asarray(centers, np.float64).reshape(-1, 3)
     x, y, yaw = (float(v) for v in np.asarray(pose)[:3])
-    forward = np.array([math.cos(yaw), math.sin(yaw), 0.0])
-    right = np.array([math.sin(yaw), -math.cos(yaw), 0.0])
-    rel = centers - np.array([x, y, float(cfg.eye_height)])
-    z = rel @ forward
     W, H = (float(v) for v in cfg.image_size)
-    f = (W / 2.0) / math.tan(math.radians(cfg.view_hfov) / 2.0)
+    K = np.asarray(G.intrinsics(W, H, math.radians(cfg.view_hfov)), np.float64)
+    R_wc = np.asarray(G.view_rotation(jnp.float32(yaw)), np.float64)  # columns: camera x, y, z in world
+    cam = (centers - np.array([x, y, float(cfg.eye_height)])) @ R_wc  # camera frame: x right, y down, z forward
+    z = cam[:, 2]
     with np.errstate(divide="ignore", invalid="ignore"):
-        u = W / 2.0 + f * (rel @ right) / z
-        v = H / 2.0 - f * rel[:, 2] / z
+        u = K[0, 0] * cam[:, 0] / z + K[0, 2]
+        v = K[1, 1] * cam[:, 1] / z + K[1, 2]
     inside = (z > 1e-6) & (u >= 0) & (u < W) & (v >= 0) & (v < H)
     col = np.where(inside, np.floor(np.where(inside, u, 0) / (W / 8)) + 1, 0)
     row = np.where(inside, np.floor((H - np.where(inside, v, H)) / (H / 8)) + 1, 0)

@@ -456,7 +456,7 @@ class HostLoop:
         """Record the episodes of rows ``ended`` (progress file, images) and free their slots."""
         for r in ended:
             ep = run.slots[r]
-            entry = self._entry(ep, outs, r, run.traj_rows.pop(ep.index), pose[r])
+            entry = R.episode_entry(self.es, self.sim, ep, outs, r, run.traj_rows.pop(ep.index), pose[r])
             run.records[ep.index] = entry
             log.append(entry)
             self._write_images(ep)
@@ -545,15 +545,12 @@ class HostLoop:
             if self.renderer is not None and self._own_renderer:
                 self.renderer.close()
         records = {**run.records, **finished}
-        return self._result(records, {"wall_s": wall, "decisions": run.decisions,
-                                      "utilisation": util, "requests": stats.requests_sent,
-                                      "retries": stats.retries, "max_in_flight": stats.max_in_flight,
-                                      "resumed": len(finished), "rerun": len(failed_before),
-                                      "failures": sum(bool(r["failure"]) for r in records.values()),
-                                      "paraphrased": sum(c["role"] == "paraphrase" for r in records.values()
-                                                         for c in r["calls"]),
-                                      "paraphrase_rejected": sum(r["accounting"]["paraphrase_rejected"]
-                                                                 for r in records.values())})
+        stats = {"wall_s": wall, "decisions": run.decisions, "utilisation": util, "requests": stats.requests_sent,
+                 "retries": stats.retries, "max_in_flight": stats.max_in_flight, "resumed": len(finished),
+                 "rerun": len(failed_before), "failures": sum(bool(r["failure"]) for r in records.values()),
+                 "paraphrased": sum(c["role"] == "paraphrase" for r in records.values() for c in r["calls"]),
+                 "paraphrase_rejected": sum(r["accounting"]["paraphrase_rejected"] for r in records.values())}
+        return R.loop_result([records[i] for i in range(self.n)], stats, self.sim)
 
     def _write_images(self, ep: _Episode) -> None:
         if self.out is None or not ep.images:
@@ -564,11 +561,6 @@ class HostLoop:
             ext = "jpg" if img.mime == "image/jpeg" else "png"
             atomic_write(folder / f"{step:03d}_{role}.{ext}", img.data)
 
-    def _entry(self, ep: _Episode, outs: dict, r: int, steps: list, final_pose) -> dict:
-        return R.episode_entry(self.es, self.sim, ep, outs, r, steps, final_pose)
-
-    def _result(self, records: dict[int, dict], stats: dict) -> LoopResult:
-        return R.loop_result([records[i] for i in range(self.n)], stats, self.sim)
 
 
 def run_llm_agent(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, *, sim: T.SimConfig = T.SimConfig(),

@@ -182,5 +182,5 @@ def hint_bearing(hint_point, pose, active):
     false: the relative bearing of the paper's controller (Appendix, Eq.
     relative-target), which keeps the hinted way's side current after a
     turn or a detour. Only the sector reaches the agent, never the angle."""
-    rel = jnp.arctan2(hint_point[1] - pose[1], hint_point[0] - pose[0]) - pose[2]
+    _, rel = G.relative_target(pose[:2], pose[2], hint_point)
     return jnp.where(active, sector_of(rel), -1).astype(jnp.int32)

@@ -95,10 +95,16 @@ def compass_degrees(yaw: float) -> float:
     return float((90.0 - math.degrees(float(yaw))) % 360.0)
 
 
+def offset_words(east: float, north: float) -> tuple[str, str]:
+    """An offset from the start in words, its two axes: ``("2.3 m east", "1.0 m south")``."""
+    return (f"{abs(east):.1f} m {'east' if east >= 0 else 'west'}",
+            f"{abs(north):.1f} m {'north' if north >= 0 else 'south'}")
+
+
 def orientation_text(d: "Decision") -> str:
     """The Planner's own heading and offset from the start, in words (the paper's runtime-wrapper fields)."""
     east, north = (float(v) for v in d.offset)
-    parts = [f"{abs(east):.1f} m {'east' if east >= 0 else 'west'}", f"{abs(north):.1f} m {'north' if north >= 0 else 'south'}"]
+    parts = offset_words(east, north)
     where = "at your start" if max(abs(east), abs(north)) < 0.05 else " and ".join(parts) + " of your start"
     return (f"Heading of your front view: {round(d.heading) % 360} degrees (0 north, 90 east, 180 south, 270 west). "
             f"Offset from start: {where}.")

@@ -28,6 +28,7 @@ label) is in these lines: only what the model wrote about the image.
 from __future__ import annotations
 
 from ignjax.agents.llm.client import ChatRequest, ImagePart
+from ignjax.agents.llm.controller import clip
 from ignjax.sim.views.compose import view_names
 
 CAPTION_CHARS = 300
@@ -67,7 +68,7 @@ def caption_reply(parsed, err):
     text = parsed.get("description") if isinstance(parsed, dict) else None
     if not isinstance(text, str) or not text.strip():
         return None, err or "field 'description' must be a non-empty string"
-    return " ".join(text.split())[:CAPTION_CHARS], None
+    return clip(text, CAPTION_CHARS), None
 
 
 async def describe_views(ctx, d) -> str:

@@ -33,6 +33,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from ignjax.agents.llm.agent import offset_words
+
 MERGE_M = 0.8
 """GTA's merge radius (delta_merge, m): a position this close to a node is that node."""
 LOOP_VISITS = 2
@@ -94,9 +96,7 @@ class PlaceGraph:
 
 
 def _where(pos) -> str:
-    east, north = pos
-    return (f"{abs(east):.1f} m {'east' if east >= 0 else 'west'}, "
-            f"{abs(north):.1f} m {'north' if north >= 0 else 'south'}")
+    return ", ".join(offset_words(*pos))
 
 
 def graph_text(g: PlaceGraph) -> str:

@@ -244,6 +244,11 @@ def schema_instance(schema: Any, rng: random.Random, root: Any = None, depth: in
     return s[: int(hi)] if hi is not None else s
 
 
+def request_text(body: dict) -> str:
+    """Every text part of a request's messages, one per line (what a reply policy reads)."""
+    return "\n".join(_texts_and_images(body)[0])
+
+
 def _texts_and_images(body: dict) -> tuple[list[str], list[tuple[str, bytes]]]:
     texts, images = [], []
     for m in body.get("messages", ()):

@@ -22,7 +22,7 @@ import pytest
 from ignjax.agents.llm.caption import CAPTION_SYSTEM, NO_CAPTION, caption_reply
 from ignjax.agents.llm.catalog import get_llm_agent
 from ignjax.agents.llm.config import LLMConfig
-from ignjax.agents.llm.serve import ScriptedServer
+from ignjax.agents.llm.serve import ScriptedServer, request_text
 from ignjax.episodes.dataset import load_benchmark
 from ignjax.evaluate.hostloop import run_llm_agent
 from ignjax.scenes import vocab
@@ -44,11 +44,6 @@ OWN_ODOMETRY = re.compile(r"Offset from start: [^\n]*?of your start\.|you moved 
 ORACLE_LINES = re.compile(r"^(- (appearance|location|last confirmation): |Active route hint: ).*$", re.MULTILINE)
 """Fact Base lines: the oracle's words (a region answer names the goal room)."""
 ROOMS = [vocab.ROOM_DISPLAY[r] for r in vocab.ALL_ROOM_LABELS if r != "other"]
-
-
-def _texts(req: dict) -> str:
-    return "\n".join(c if isinstance(c, str) else "\n".join(p.get("text", "") for p in c if p.get("type") == "text")
-                     for c in (m["content"] for m in req["messages"]))
 
 
 def _images(req: dict) -> list[str]:
@@ -114,8 +109,8 @@ def test_navgpt_plans_from_captions_without_ground_truth(episodes, tmp_path):
     assert planner and len(captions) == len(names) * len(planner) and len(seen) == len(planner) + len(captions)
     # the Planner reads no image and no ground truth; the captioner one image each, the same prompt for every view
     assert all(not _images(r) for r in planner) and all(len(_images(r)) == 1 for r in captions)
-    assert {_texts(r) for r in captions} == {f"{CAPTION_SYSTEM}\nDescribe this view."}
-    assert not [(i, x) for i, r in enumerate(planner) for x in _leaks(_texts(r))]
+    assert {request_text(r) for r in captions} == {f"{CAPTION_SYSTEM}\nDescribe this view."}
+    assert not [(i, x) for i, r in enumerate(planner) for x in _leaks(request_text(r))]
     system = planner[0]["messages"][0]["content"]
     assert "captioning model" in system and "8x8 grid you do not see" in system
     # per Planner decision, one caption record per view before it; its lines are those captions, in view order
@@ -145,5 +140,5 @@ def test_the_ground_truth_text_ablation_trips_the_same_checks(episodes, tmp_path
     with ScriptedServer(policy=_policy(seen)) as srv:
         run_llm_agent(episodes, get_llm_agent("navgpt", observation="text"), _llm(srv, tmp_path / "c"), sim=SIM,
                       views=VIEWS, batch=2)  # the settings above: the loop's programs compile once
-    leaks = [x for r in seen for x in _leaks(_texts(r))]
+    leaks = [x for r in seen for x in _leaks(request_text(r))]
     assert "You seem to be in" in leaks and any(METRES.fullmatch(x) for x in leaks)

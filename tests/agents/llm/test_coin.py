@@ -24,7 +24,7 @@ from ignjax.agents.llm.catalog import get_llm_agent
 from ignjax.agents.llm.client import ImagePart
 from ignjax.agents.llm.config import LLMConfig
 from ignjax.agents.llm.controller import CORRECTIONS
-from ignjax.agents.llm.serve import ScriptedServer
+from ignjax.agents.llm.serve import ScriptedServer, request_text
 from ignjax.agents.llm.tandem import Tandem, TandemMemory
 from ignjax.episodes.dataset import load_benchmark
 from ignjax.evaluate.hostloop import run_llm_agent
@@ -159,16 +159,8 @@ SELF_CHECK = {"the blue chair": _self_reply(("it is blue", "certain", "contradic
 CONFLICT = "so it is not the target; do not ask a confirmation question or stop here"
 
 
-def _texts(req: dict) -> str:
-    out = []
-    for m in req["messages"]:
-        c = m["content"]
-        out += [c] if isinstance(c, str) else [p.get("text", "") for p in c if p.get("type") == "text"]
-    return "\n".join(out)
-
-
 def _policy(req: dict) -> str:
-    text, name = _texts(req), req["response_format"]["json_schema"]["name"]
+    text, name = request_text(req), req["response_format"]["json_schema"]["name"]
     if name == "self_questions":
         return json.dumps(SELF_CHECK[re.search(r"Object to check: (.*)", text).group(1).strip()])
     if name in ("candidate_cell", "grounder_cell"):

@@ -22,7 +22,7 @@ import pytest
 from ignjax.agents.llm.agent import ASK, MOVE, STOP, Decision, compass_degrees, orientation_text
 from ignjax.agents.llm.catalog import LLM_AGENTS, get_llm_agent
 from ignjax.agents.llm.config import LLMConfig
-from ignjax.agents.llm.serve import ScriptedServer, scripted_reply
+from ignjax.agents.llm.serve import ScriptedServer, request_text, scripted_reply
 from ignjax.agents.llm.controller import CORRECTIONS
 from ignjax.agents.llm.tandem import RECOVERY_MOVES, TandemMemory
 from ignjax.episodes.dataset import load_benchmark
@@ -310,14 +310,6 @@ def _llm(srv, **kw):
     return LLMConfig(endpoints=(srv.base_url,), model=srv.model, api_key_env=None, timeout_s=10.0, **kw)
 
 
-def _texts(req: dict) -> str:
-    out = []
-    for m in req["messages"]:
-        c = m["content"]
-        out += [c] if isinstance(c, str) else [p.get("text", "") for p in c if p.get("type") == "text"]
-    return "\n".join(out)
-
-
 SCRIPT = {1: _plan("ask", question_type=1), 2: _plan("ask", question_type=1),
           3: _plan("move", direction="left", subgoal="the open doorway"),
           4: _plan("move", direction="front-right", subgoal="the corner by the window"), 5: _plan("stop"), 6: _plan("stop")}
@@ -342,7 +334,7 @@ def _grounded(req: dict, text: str) -> str | None:
 
 
 def _script_policy(req: dict) -> str:
-    text = _texts(req)
+    text = request_text(req)
     if (grounded := _grounded(req, text)) is not None:
         return grounded
     turn = int(re.search(r"Turn (\d+) of", text).group(1))
@@ -417,7 +409,7 @@ HINT_SCRIPT = {1: _plan("ask", question_type=3), 2: _plan("move", direction="lef
 
 
 def _hint_policy(req: dict) -> str:
-    turn = int(re.search(r"Turn (\d+) of", _texts(req)).group(1))
+    turn = int(re.search(r"Turn (\d+) of", request_text(req)).group(1))
     return json.dumps({**HINT_SCRIPT.get(turn, _plan("stop")), "col": 4, "row": 2})
 
 
@@ -466,7 +458,7 @@ SCHEDULE_SCRIPT = {1: _plan("move", direction="front", subgoal="the open doorway
 
 
 def _schedule_policy(req: dict) -> str:
-    text = _texts(req)
+    text = request_text(req)
     if (grounded := _grounded(req, text)) is not None:
         return grounded
     if CORRECTIONS["stop_after_no"] in text:  # a move that gets somewhere on this episode
@@ -529,7 +521,7 @@ def test_baselines_send_what_they_should(episodes, name):
         assert "grounder_cell" not in kinds  # one stage: no Grounder
         assert "col" in planner[0]["response_format"]["json_schema"]["schema"]["properties"]
     if name == "gta":  # the place graph in every Planner request, the counterfactual field in its schema
-        assert all("Place graph" in _texts(r) for r in planner)
+        assert all("Place graph" in request_text(r) for r in planner)
         assert "counterfactuals" in planner[0]["response_format"]["json_schema"]["schema"]["required"]
     if name == "tandem-no-qa":
         enum = planner[0]["response_format"]["json_schema"]["schema"]["properties"]["action"]["enum"]
