@@ -105,8 +105,14 @@ def main(argv=None) -> int:
     from ignjax.episodes.dataset import load_benchmark
     from ignjax.evaluate.runner import make_world
     from ignjax.sim.rollout import batch_parts
-    from ignjax.sweep.stages import SHIPPED_BENCHMARK
+    from ignjax.data.shipped import shipped_episodes
+    from ignjax.errors import IgnjaxError
 
+    try:
+        episodes = args.episodes or shipped_episodes()
+    except IgnjaxError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
     device = f"{jax.default_backend()}: {jax.devices()[0].device_kind} x{jax.device_count()}"
     log(f"device {device}")
     res: dict = {"device": device, "quick": args.quick}
@@ -114,7 +120,7 @@ def main(argv=None) -> int:
         from ignjax.bench.llm import bench_llm
 
         log("MLLM host loop against the scripted server ...")
-        res["llm"] = bench_llm(load_benchmark(args.episodes or SHIPPED_BENCHMARK), args.quick)
+        res["llm"] = bench_llm(load_benchmark(episodes), args.quick)
         print(json.dumps(res, sort_keys=True) if args.json else json.dumps(res, indent=2, sort_keys=True))
         return 0
     if args.scaling:
@@ -123,22 +129,22 @@ def main(argv=None) -> int:
         from ignjax.episodes.dataset import open_benchmark
 
         log("how cost grows (EIG rollout) ...")
-        res["scaling"] = growth_curves(open_benchmark(args.episodes or SHIPPED_BENCHMARK), args.quick)
+        res["scaling"] = growth_curves(open_benchmark(episodes), args.quick)
         res["scaling"]["device"] = device
         res["scaling"]["files"] = write_growth(res["scaling"], args.out)
         log(f"  wrote {res['scaling']['files']['png']}")
         print(json.dumps(res, sort_keys=True) if args.json else json.dumps(res, indent=2, sort_keys=True))
         return 0
     if args.time_to_result:
-        res["time_to_result"] = _time_to_result(args.episodes)
+        res["time_to_result"] = _time_to_result(episodes)
         print(json.dumps(res, sort_keys=True) if args.json else json.dumps(res, indent=2, sort_keys=True))
         return 0
     if args.pieces:
-        es = load_benchmark(args.episodes or SHIPPED_BENCHMARK)
+        es = load_benchmark(episodes)
         res["pieces"] = _pieces(es, make_world(es), ("random", "eig") if args.quick else AGENTS)
         print(json.dumps(res, sort_keys=True) if args.json else json.dumps(res, indent=2, sort_keys=True))
         return 0
-    res["time_to_result"] = _time_to_result(args.episodes)  # first: fresh processes, this one still small
+    res["time_to_result"] = _time_to_result(episodes)  # first: fresh processes, this one still small
     log("rays ...")
     res.update(bench_rays(args.quick))
     r = res["rays_per_s"]
@@ -149,7 +155,7 @@ def main(argv=None) -> int:
     res["probe_ray_agreement"] = bench_probe_rays(args.quick)
     log("  probe-map rays within one cell of mj_ray: " + ", ".join(
         f"{k} {v:.4f}" for k, v in res["probe_ray_agreement"].items()))
-    es = load_benchmark(args.episodes or SHIPPED_BENCHMARK)
+    es = load_benchmark(episodes)
     world = make_world(es)
     log("rendered observations ...")
     res["render"] = bench_render(es.bank, args.quick)
@@ -176,10 +182,9 @@ def main(argv=None) -> int:
 def _time_to_result(episodes) -> dict:
     """:func:`ignjax.bench.time_to_result.bench_time_to_result`, with its progress lines."""
     from ignjax.bench.time_to_result import bench_time_to_result
-    from ignjax.sweep.stages import SHIPPED_BENCHMARK
 
     log("time to result (fresh processes; cold = empty cache folder, then warm) ...")
-    return bench_time_to_result(str(episodes or SHIPPED_BENCHMARK), log=log)
+    return bench_time_to_result(str(episodes), log=log)
 
 
 def _pieces(es, world, agents) -> dict:

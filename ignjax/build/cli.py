@@ -6,6 +6,11 @@ Sub-commands::
     python -m ignjax.build inspect PATH [--json]
     python -m ignjax.build episodes --scenes PATH... --out FILE.jsonl.gz [--subset N] [--seed S] [--alpha a1,a2,a3,a4] [--workers N]
     python -m ignjax.build episodes --check FILE
+    python -m ignjax.build default --out DIR [--workers N]
+
+``default`` writes the shipped benchmark (:mod:`ignjax.data.shipped`) again
+into ``DIR`` and checks every file against the recorded hashes (exit 1 when
+one differs).
 
 Errors on bad input are printed as one line naming the file, the place in it
 and the reason, and the command exits with status 2 without writing
@@ -272,6 +277,28 @@ def cmd_render(args) -> int:
     return 0
 
 
+def cmd_default(args) -> int:
+    """The shipped benchmark again (:mod:`ignjax.data.shipped`): its houses and
+    episode files written into ``--out``, then compared with the recorded hashes."""
+    from ignjax.data import shipped
+
+    out = Path(args.out)
+    common = ["--workers", str(args.workers)] + (["--quiet"] if args.quiet else [])
+    steps = (["scenes", "--out", str(out), "--count", str(shipped.SCENE_COUNT), "--seed", str(shipped.SCENE_SEED)],
+             ["episodes", "--scenes", str(out), "--out", str(out / shipped.EPISODES.name),
+              "--subset", str(shipped.SUBSET), "--seed", str(shipped.EPISODE_SEED)])
+    for step in steps:
+        sub_args = build_parser().parse_args(step + common)
+        sub_args.func(sub_args)
+    bad = shipped.mismatches(out, shipped.recorded_hashes())
+    if bad:
+        print(f"{out} differs from the shipped benchmark: " + "; ".join(bad), file=sys.stderr)
+        return 1
+    print(f"{out} holds the shipped benchmark, byte for byte; use it with --set benchmark.episodes="
+          f"{out / shipped.EPISODES.name} (sweep) or --episodes {out / shipped.EPISODES.name} (evaluate)")
+    return 0
+
+
 def cmd_episodes(args) -> int:
     # imported on use, so that --help and the other commands answer at once
     from ignjax.build.episodes import run_episodes_command
@@ -316,6 +343,13 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--backend", default="auto", choices=("auto", "warp", "egl"),
                    help="renderer (default auto: MuJoCo Warp when installed, else OpenGL)")
     r.set_defaults(func=cmd_render)
+
+    d = sub.add_parser("default", help="write the shipped benchmark (12 houses, 500 episodes) again, byte for byte, "
+                                       "and check it against the recorded hashes")
+    d.add_argument("--out", required=True, help="output folder (created if missing)")
+    d.add_argument("--workers", type=int, default=1, help="processes, as for scenes and episodes (default 1)")
+    d.add_argument("--quiet", action="store_true", help="no progress bars")
+    d.set_defaults(func=cmd_default)
 
     e = sub.add_parser("episodes", help="build a benchmark from scenes, or --check an episode file")
     e.add_argument("--scenes", nargs="+", help="scene sources: the scenes/ folder, USD files, ProcTHOR JSON/JSONL, glTF")

@@ -2,8 +2,11 @@
 
 ::
 
-    python -m ignjax.evaluate --episodes bench/e.jsonl.gz --agent eig [--agent naive_asker ...]
+    python -m ignjax.evaluate --agent eig [--agent naive_asker ...] [--episodes bench/e.jsonl.gz]
                               [--out runs/eval] [--batch 256] [--seed 0]
+
+Without ``--episodes`` it runs on the shipped benchmark (package data,
+:mod:`ignjax.data.shipped`).
 
 Writes ``OUT/outcomes.parquet`` and ``OUT/outcomes.csv`` (one row per agent
 and episode; see :mod:`ignjax.evaluate.outcomes`), ``OUT/metrics.csv`` (every metric per
@@ -73,6 +76,8 @@ import numpy as np
 from ignjax.arrays import parse_assignment, parse_floats
 from ignjax.cache import add_cache_arguments, apply_cache_arguments
 from ignjax.devices import processes as PR
+from ignjax import __version__
+from ignjax.data.shipped import shipped_episodes
 from ignjax.errors import ConfigError, IgnjaxError
 from ignjax.fileio import atomic_write
 from ignjax.protocol import LOCKED_COSTS, SUCCESS_THRESHOLDS
@@ -88,7 +93,8 @@ def build_parser() -> argparse.ArgumentParser:
                                 formatter_class=argparse.RawDescriptionHelpFormatter,
                                 epilog="agents:\n" + "\n".join(f"  {a.name:14s} {a.description}" for a in agents.values())
                                 + "".join(f"\n  {n:14s} {c.description}" for n, c in LLM_AGENTS.items()))
-    p.add_argument("--episodes", required=True, help="episode file (.jsonl or .jsonl.gz) from `ignjax.build.cli episodes`")
+    p.add_argument("--episodes", help="episode file (.jsonl or .jsonl.gz) from `python -m ignjax.build episodes` "
+                                      "(default: the shipped benchmark, 500 episodes in 12 houses)")
     p.add_argument("--agent", action="append", required=True, help="agent name; repeat for several agents")
     p.add_argument("--out", default="runs/eval", help="output folder (default runs/eval)")
     p.add_argument("--batch", type=int, default=256, help="episodes per compiled batch (default 256)")
@@ -287,7 +293,9 @@ def check_settings(args, popts: PR.ProcessOptions = PR.ProcessOptions()) -> dict
         raise ConfigError(None, "--bank-mb", f"must be > 0, got {args.bank_mb}")
     if args.parts < 0:
         raise ConfigError(None, "--parts", f"must be >= 0, got {args.parts}")
-    if not Path(args.episodes).is_file():
+    if args.episodes is None:
+        args.episodes = str(shipped_episodes())
+    elif not Path(args.episodes).is_file():
         raise ConfigError(None, "--episodes", f"{args.episodes}: file not found")
     return {"agents": agents, "sim": sim, "agent_values": agent_values, "out_dir": out_dir, "llm_agents": llm_agents,
             "llm": llm, "views": views, "thresholds": thresholds, "costs": costs}
@@ -451,7 +459,7 @@ def _write_outputs(args, st: dict, bs, plan, store, used: dict, llm_names: set) 
     write_trajectories(out_dir, trajectories, records, episodes=args.episodes, scenes_root=args.scenes_root,
                        categories=bs.host.categories, thresholds=thresholds, costs=costs,
                        require_stop=args.require_stop, sim=sim.to_dict())
-    run_record = {"episodes": str(args.episodes), "seed": args.seed, "batch": args.batch, "thresholds": list(thresholds),
+    run_record = {"ignjax_version": __version__, "episodes": str(args.episodes), "seed": args.seed, "batch": args.batch, "thresholds": list(thresholds),
                   "costs": list(costs), "require_stop": args.require_stop,
                   "success_rule": M.success_rule(args.require_stop), "sim": sim.to_dict(), "agents": used,
                   "limit": args.limit, "bank_mb": args.bank_mb, "image_size": _image_size(st),

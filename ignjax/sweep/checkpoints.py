@@ -10,6 +10,7 @@ from pathlib import Path
 
 import orbax.checkpoint as ocp
 
+from ignjax import __version__
 from ignjax.config import SweepConfig, fingerprint
 from ignjax.errors import InputError
 from ignjax.fileio import atomic_write, remove_leftover_temporaries
@@ -36,8 +37,8 @@ def prepare_folder(out: Path, cfg: SweepConfig, studies: list[str], resume: bool
             remove_leftover_temporaries(out)  # a file being written when the killed run stopped
     out.mkdir(parents=True, exist_ok=True)
     if not meta.is_file():
-        atomic_write(meta, json.dumps({"fingerprint": fp, "studies": studies, "config": cfg.to_dict()}, indent=2,
-                                      sort_keys=True) + "\n")
+        record = {"fingerprint": fp, "ignjax_version": __version__, "studies": studies, "config": cfg.to_dict()}
+        atomic_write(meta, json.dumps(record, indent=2, sort_keys=True) + "\n")
 
 
 class Checkpoints:

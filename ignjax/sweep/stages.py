@@ -40,6 +40,7 @@ from ignjax.devices.processes import SINGLE, ProcessGroup
 from ignjax.episodes.construct import BuildConfig, build_benchmark
 from ignjax.episodes.dataset import BenchmarkScenes, open_benchmark
 from ignjax.episodes.schema import construction_path, read_episodes, write_records
+from ignjax.data import shipped
 from ignjax.errors import ConfigError, InputError
 from ignjax.evaluate.runner import BucketPlan, agent_batches, batch_program, bucket_worlds, episode_batches, plan_run
 from ignjax.scenes.io.sources import scene_sources
@@ -47,8 +48,6 @@ from ignjax.sim.rollout import batch_parts, compile_ahead, rollout_sweep
 from ignjax.sweep.checkpoints import Checkpoints, prepare_folder
 from ignjax.sweep.report import in_loop_costs, write_outputs
 
-REPO_SCENES = Path(__file__).resolve().parents[2] / "scenes"
-SHIPPED_BENCHMARK = REPO_SCENES / "benchmark.jsonl.gz"
 
 
 def _to_tree(obj) -> dict:
@@ -70,10 +69,11 @@ def benchmark_path(cfg: SweepConfig, out_root: Path, progress=None) -> Path:
         if not p.is_file():
             raise InputError(str(p), "benchmark.episodes", "episode file not found")
         return p
-    default = not b.scenes and b.subset == 500 and b.seed == 0
-    if default and SHIPPED_BENCHMARK.is_file():
-        return SHIPPED_BENCHMARK
-    scenes = [Path(b.scenes)] if b.scenes else [REPO_SCENES]
+    if not b.scenes:
+        episodes = shipped.shipped_episodes()  # checked against the recorded hashes
+        if b.subset == shipped.SUBSET and b.seed == shipped.EPISODE_SEED:
+            return episodes
+    scenes = [Path(b.scenes)] if b.scenes else [shipped.FOLDER]
     for s in scenes:
         if not s.exists():
             raise InputError(str(s), "benchmark.scenes", "scene path not found")
@@ -279,6 +279,8 @@ def run_sweep(cfg: SweepConfig, studies: list[str], out: Path, *, resume: bool =
         raise InputError(cfg.derive_costs.annotations, "derive-costs.annotations", "file not found")
     check_model_server(cfg, studies)
     needs_rollouts = any(s in studies for s in ("eval", "costs", "difficulty", "analysis"))
+    if needs_rollouts and not cfg.benchmark.episodes and not cfg.benchmark.scenes:
+        shipped.shipped_episodes()  # a damaged default is one error before the run folder is touched
     agents = list(dict.fromkeys(list(cfg.eval.agents) + ([cfg.analysis.agent] if "analysis" in studies else [])))
     if needs_rollouts:
         try:  # this process's devices (before any work)
@@ -308,7 +310,7 @@ def run_sweep(cfg: SweepConfig, studies: list[str], out: Path, *, resume: bool =
                               f"{cfg.eval.bank_mb:g}; the MLLM agents ({', '.join(llm_agents)}) run on one bank: "
                               "raise eval.bank_mb, or run fewer episodes (benchmark.limit)")
         if group.main:
-            print(f"benchmark {path} ({len(bs)} episodes in {bs.host.n_scenes} scenes"
+            print(f"benchmark {shipped.describe(path)} ({len(bs)} episodes in {bs.host.n_scenes} scenes"
                   + (f", {len(plan.buckets)} buckets run one at a time" if len(plan.buckets) > 1 else "")
                   + f") ready in {time.perf_counter() - t0:.1f} s", file=sys.stderr)
         ckpt = Checkpoints(out / "checkpoints")
@@ -352,5 +354,5 @@ def run_sweep(cfg: SweepConfig, studies: list[str], out: Path, *, resume: bool =
     return results if group.main else {}
 
 
-__all__ = ["REPO_SCENES", "SHIPPED_BENCHMARK", "benchmark_path", "check_model_server", "load_episodes", "merge_stage",
+__all__ = ["benchmark_path", "check_model_server", "load_episodes", "merge_stage",
            "model_failures", "rollout_stage_parts", "run_llm_stage", "run_sweep"]

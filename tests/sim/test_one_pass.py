@@ -27,7 +27,7 @@ from ignjax.sim import executor as X
 from ignjax.sim.compact import one_pass
 from ignjax.sim.observation import sight_batch
 from ignjax.sim.rollout import episode_keys, rollout
-from ignjax.sweep.stages import SHIPPED_BENCHMARK
+from ignjax.data.shipped import EPISODES as SHIPPED_BENCHMARK
 
 B = 4096
 

@@ -71,12 +71,13 @@ from dataclasses import dataclass
 from email.utils import parsedate_to_datetime
 from typing import Any, Sequence
 
-import aiohttp
-
 from ignjax.agents.llm.cache import ResponseCache, request_hash
 from ignjax.agents.llm.config import LLMConfig
 from ignjax.agents.llm.parse import parse_reply
 from ignjax.errors import ConfigError, IgnjaxError, InputError
+from ignjax.errors.extras import optional_module, require_extra
+
+aiohttp = optional_module("aiohttp", "llm")  # the llm extra: pip install "ignjax[llm]"
 
 log = logging.getLogger("ignjax.agents.llm")
 
@@ -384,6 +385,7 @@ class ChatClient:
     def __init__(self, config: LLMConfig, cache: ResponseCache | None = None):
         if not isinstance(config, LLMConfig):
             raise TypeError(f"expected an LLMConfig, got {type(config).__name__}")
+        require_extra("aiohttp", "llm")
         config.check_usable()
         self.config = config
         self._own_cache = cache is None and config.cache_dir is not None  # opened when entered

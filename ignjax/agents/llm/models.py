@@ -27,11 +27,12 @@ import asyncio
 import json
 import os
 
-import aiohttp
-
 from ignjax.agents.llm.client import _Secret, server_message
 from ignjax.agents.llm.config import LLMConfig
 from ignjax.errors import ConfigError
+from ignjax.errors.extras import optional_module, require_extra
+
+aiohttp = optional_module("aiohttp", "llm")  # the llm extra: pip install "ignjax[llm]"
 
 
 class _Unanswered(Exception):
@@ -102,7 +103,9 @@ def check_served(config: LLMConfig, model_setting: str = "llm.model", endpoints_
     Raises:
         ConfigError: naming ``endpoints_setting`` and each endpoint that gave no model list, with why;
             else naming ``model_setting``, the model asked for and the models each endpoint serves.
+        MissingExtra: the llm extra (aiohttp) is not installed.
     """
+    require_extra("aiohttp", "llm")
     if config.replay or not config.endpoints:
         return
     key = _key(config)

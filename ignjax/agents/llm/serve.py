@@ -83,10 +83,11 @@ import time
 from dataclasses import dataclass
 from typing import Any, Callable
 
-from aiohttp import web
-
 from ignjax.agents.llm.parse import resolve_ref
 from ignjax.errors import ConfigError
+from ignjax.errors.extras import optional_module
+
+web = optional_module("aiohttp.web", "llm")
 
 DEFAULT_MODEL = "ignjax-scripted"
 NAMED_FAULTS = ("slow", "drop", "malformed", "truncated")

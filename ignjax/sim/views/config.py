@@ -145,7 +145,7 @@ class ViewConfig:
 def warp_available() -> str | None:
     """None when the warp backend can run here, else the reason."""
     if importlib.util.find_spec("warp") is None:
-        return f"the warp backend needs the {WARP_PACKAGE!r} package (pip install {WARP_PACKAGE})"
+        return f"the warp backend needs the {WARP_PACKAGE!r} package (pip install \"ignjax[render]\")"
     return None
 
 

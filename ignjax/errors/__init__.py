@@ -66,3 +66,4 @@ def warn_again(caught, stacklevel: int = 3) -> None:
 
     for category, message in caught:
         warnings.warn(message, category, stacklevel=stacklevel)
+
