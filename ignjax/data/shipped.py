@@ -17,7 +17,10 @@ rebuilds the benchmark byte for byte (:data:`REBUILD`).
 from __future__ import annotations
 
 import functools
+import gzip
 import hashlib
+import json
+import math
 from pathlib import Path
 
 from ignjax.errors import InputError
@@ -74,6 +77,35 @@ def mismatches(folder: Path, hashes: dict[str, str]) -> list[str]:
     return out
 
 
+def _differences(a, b, where: str, rel: float) -> list[str]:
+    """Where two JSON values differ, floats compared within ``rel`` (relative)."""
+    if isinstance(a, float) or isinstance(b, float):
+        ok = isinstance(a, (int, float)) and isinstance(b, (int, float)) and math.isclose(a, b, rel_tol=rel, abs_tol=rel)
+        return [] if ok else [f"{where}: {a!r} vs {b!r}"]
+    if isinstance(a, dict) and isinstance(b, dict):
+        return [d for k in sorted(set(a) | set(b)) for d in _differences(a.get(k), b.get(k), f"{where}.{k}", rel)]
+    if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
+        return [d for i, (u, v) in enumerate(zip(a, b)) for d in _differences(u, v, f"{where}[{i}]", rel)]
+    return [] if a == b else [f"{where}: {a!r} vs {b!r}"]
+
+
+def episode_differences(path: Path, rel: float = 1e-9) -> tuple[list[str], int]:
+    """``(differences, rounded)``: how the episode file at ``path`` differs from
+    the shipped one beyond floating-point rounding (each ``"<episode
+    field>: <ours> vs <shipped>"``), and how many numbers differ only in their
+    last digits (what another numpy build or CPU gives)."""
+    def load(p):
+        with gzip.open(p, "rt") as f:
+            return [json.loads(line) for line in f if line.strip()]
+
+    ours, recorded = load(path), load(EPISODES)
+    if len(ours) != len(recorded):
+        return [f"{len(ours)} episodes vs {len(recorded)}"], 0
+    diffs = [d for i, (u, v) in enumerate(zip(ours, recorded)) for d in _differences(u, v, f"episode {i}", rel)]
+    exact = [d for i, (u, v) in enumerate(zip(ours, recorded)) for d in _differences(u, v, f"episode {i}", 0.0)]
+    return diffs, len(exact) - len(diffs)
+
+
 def _damaged(path: Path, reason: str) -> InputError:
     return InputError(f"{LABEL}, {path}", None,
                       f"{reason}; reinstall ignjax (pip install --force-reinstall ignjax), or rebuild it with "
@@ -108,4 +140,4 @@ def shipped_episodes() -> Path:
 
 
 __all__ = ["EPISODES", "EPISODE_SEED", "FOLDER", "HASHES", "LABEL", "REBUILD", "SCENE_COUNT", "SCENE_SEED", "SUBSET",
-           "describe", "file_sha256", "mismatches", "recorded_hashes", "shipped_episodes"]
+           "describe", "episode_differences", "file_sha256", "mismatches", "recorded_hashes", "shipped_episodes"]

@@ -5,6 +5,8 @@ rebuilding command (exit status 2), before any run folder is written."""
 
 from __future__ import annotations
 
+import gzip
+import json
 import shutil
 import subprocess
 import sys
@@ -89,3 +91,42 @@ def test_the_main_job_stops_on_a_damaged_default_before_writing_anything(damaged
     assert len(lines) == 1 and lines[0].startswith("error: the shipped benchmark (package data)"), proc.stderr
     assert "benchmark.jsonl.gz" in lines[0] and shipped.REBUILD in lines[0]
     assert not out.exists()
+
+
+def _rewrite_episodes(src: Path, dst: Path, change) -> None:
+    with gzip.open(src, "rt") as f:
+        records = [json.loads(line) for line in f]
+    change(records)
+    with gzip.open(dst, "wt") as f:
+        f.writelines(json.dumps(r) + "\n" for r in records)
+
+
+def _first_float(record: dict) -> str:
+    return next(k for k, v in record.items() if isinstance(v, float))
+
+
+def test_a_rebuild_differing_only_by_rounding_holds_the_same_episodes(tmp_path):
+    def round_off(records):
+        k = _first_float(records[3])
+        records[3][k] = records[3][k] * (1 + 1e-15) + 1e-300
+    ours = tmp_path / "benchmark.jsonl.gz"
+    _rewrite_episodes(shipped.EPISODES, ours, round_off)
+    assert shipped.episode_differences(ours) == ([], 1)
+
+
+def test_a_rebuild_with_another_target_differs(tmp_path):
+    def retarget(records):
+        records[7]["target_id"] = records[7]["target_id"] + "_other"
+    ours = tmp_path / "benchmark.jsonl.gz"
+    _rewrite_episodes(shipped.EPISODES, ours, retarget)
+    diffs, _ = shipped.episode_differences(ours)
+    assert len(diffs) == 1 and diffs[0].startswith("episode 7.target_id:")
+
+
+@pytest.mark.slow
+def test_build_default_writes_the_shipped_benchmark_again(tmp_path):
+    """About 1.5 minutes on two cores: the 12 houses and 500 episodes, rebuilt and compared."""
+    proc = subprocess.run([sys.executable, "-m", "ignjax.build", "default", "--out", str(tmp_path / "d"), "--workers",
+                           "2", "--quiet"], capture_output=True, text=True, timeout=1200)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert "holds the shipped benchmark" in proc.stdout
