@@ -32,6 +32,11 @@ class Agent:
             never a fair competitor).
         asks: may ask questions.
         description: one line for ``--help`` and reports.
+        reads: the parameters that change what the agent does, as its
+            ``act`` uses them (the report's setup lists only these); None:
+            all of its parameters. A belief agent shares
+            :class:`~ignjax.agents.belief.BeliefParams` with the others but
+            reads only some of its fields.
     """
 
     name: str
@@ -41,6 +46,7 @@ class Agent:
     privileged: bool = False
     asks: bool = False
     description: str = ""
+    reads: tuple[str, ...] | None = None
 
 
 __all__ = ["Agent"]

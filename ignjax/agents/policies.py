@@ -208,7 +208,11 @@ def _explorer_act(params, obs, answers, mem, key, priv):
 
 
 EXPLORER = Agent("explorer", _belief_init, _explorer_act, default_belief_params,
-                 description="no questions: explores, stops at the nearest instance of the goal category it saw")
+                 description="never asks: explores, then walks to the nearest instance of the goal category it has "
+                             "seen and stops there",
+                 # its belief is one-hot on the nearest seen instance, so only the stopping range matters
+                 # (commit is always met, p_stop is fixed to 0.5; no answers, so no route hint to follow or stop on)
+                 reads=("stop_range",))
 
 
 # described (no questions, uses a description given at reset) -----------------
@@ -220,8 +224,9 @@ def _described_act(params, obs, answers, mem, key, priv):
 
 
 DESCRIBED = Agent("described", _belief_init, _described_act, default_belief_params,
-                  description="no questions: the belief agent on what it sees plus the target description when it is "
-                              "given at reset (sim.upfront_description); the paper's no-QA ablation")
+                  description="never asks: the belief agent on what it sees plus the target description when it is "
+                              "given at reset (sim.upfront_description); the paper's no-QA ablation",
+                  reads=("commit", "p_stop", "stop_range", "prior_count"))  # no answers: no route hint
 
 
 # naive asker ------------------------------------------------------------------
@@ -244,7 +249,9 @@ def _naive_act(params, obs, answers, mem, key, priv):
 
 
 NAIVE_ASKER = Agent("naive_asker", _belief_init, _naive_act, default_belief_params, asks=True,
-                    description="asks freely (Type 1, 2 first; Type 4 at candidates; Type 3 every third step)")
+                    description="asks freely, ignoring costs: Type 1 and 2 first, Type 4 at every plausible "
+                                "candidate, Type 3 every third step",
+                    reads=("commit", "p_stop", "stop_range", "prior_count", "follow_up", "hint_stop", "hint_follow"))
 
 
 # EIG agent ------------------------------------------------------------------------
@@ -311,7 +318,8 @@ def _eig_act(params, obs, answers, mem, key, priv):
 
 
 EIG = Agent("eig", _belief_init, _eig_act, default_belief_params, asks=True,
-            description="cost-aware: asks argmax_t EIG_t / w_t when it exceeds a threshold (Eq. 1 on its belief)")
+            description="cost-aware: asks the question type with the largest expected information gain per unit "
+                        "cost when that ratio exceeds `threshold`, else moves on its belief")
 
 
 __all__ = ["DEADLINE_STEPS", "DESCRIBED", "EIG", "EXPLORER", "NAIVE_ASKER", "PASSAGE_LABELS", "PathParams", "RANDOM",

@@ -52,7 +52,7 @@ def success_rule(require_stop: bool, distance: str = "geodesic") -> str:
     rule = f"success = final {distance} distance <= tau"
     if require_stop:
         return rule + " and an explicit STOP (Habitat's convention, not the paper's)"
-    return rule + " (the paper's Eq. wsr; an episode ends by STOP or by the step budget)"
+    return rule + " (the paper's rule: an episode ends by STOP or by the step budget, and either counts)"
 
 
 def question_discount(n_questions, costs=LOCKED_COSTS):
@@ -190,17 +190,20 @@ def metric_row(outcomes: OutcomeRow, thresholds=DEFAULT_THRESHOLDS, costs=LOCKED
     return row
 
 
-def md_table(header: list[str], rows: list[list]) -> str:
-    """A markdown table: strings as given, floats to 4 significant digits (``nan`` when not finite)."""
-    def cell(v):
-        if isinstance(v, str):
-            return v
-        if isinstance(v, (float, np.floating)):
-            return "nan" if not np.isfinite(float(v)) else f"{float(v):.4g}"
-        return str(v)
+def md_cell(v) -> str:
+    """One cell of a GitHub-flavoured markdown table: strings as given, floats
+    to 4 significant digits (``nan`` when not finite); a ``|`` in the text
+    (the ``|Q|`` columns) is escaped as ``\\|`` so it does not split the cell."""
+    if isinstance(v, (float, np.floating)):
+        v = "nan" if not np.isfinite(float(v)) else f"{float(v):.4g}"
+    return str(v).replace("\\|", "|").replace("|", "\\|")
 
-    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
-    lines += ["| " + " | ".join(cell(v) for v in r) + " |" for r in rows]
+
+def md_table(header: list[str], rows: list[list]) -> str:
+    """A GitHub-flavoured markdown table (cells by :func:`md_cell`): every
+    row has as many cells as the header."""
+    lines = ["| " + " | ".join(md_cell(h) for h in header) + " |", "|" + "|".join("---" for _ in header) + "|"]
+    lines += ["| " + " | ".join(md_cell(v) for v in r) + " |" for r in rows]
     return "\n".join(lines)
 
 

@@ -35,8 +35,8 @@ benchmark settings are the defaults; else one built from
 ``benchmark.scenes`` into ``<run.out>/_benchmarks/`` and reused.
 ``benchmark.limit`` keeps N episodes spread evenly over the file (quick runs).
 
-Modules, lowest first: :mod:`~ignjax.sweep.report` (the studies' tables,
-figures and ``report.md``), :mod:`~ignjax.sweep.checkpoints` (the run
+Modules, lowest first: :mod:`~ignjax.sweep.report` (the studies' tables
+and figures), :mod:`~ignjax.sweep.sections` (the text of ``report.md``), :mod:`~ignjax.sweep.checkpoints` (the run
 folder and its orbax checkpoints), :mod:`~ignjax.sweep.stages` (benchmark,
 rollout stages, :func:`~ignjax.sweep.stages.run_sweep`) and
 :mod:`~ignjax.sweep.cli` (the command line). The configuration is

@@ -1,4 +1,5 @@
-"""Studies' tables, figures and ``report.md`` of a sweep run (:mod:`ignjax.sweep.stages`).
+"""Studies' tables and figures of a sweep run (:mod:`ignjax.sweep.stages`); the text of ``report.md`` around
+them is :mod:`ignjax.sweep.sections`.
 
 Everything here is a deterministic function of the rollouts and the
 configuration, so an interrupted-and-resumed run writes the same bytes as
@@ -12,7 +13,7 @@ import csv
 import io
 import math
 from pathlib import Path
-from types import MappingProxyType, SimpleNamespace
+from types import SimpleNamespace
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -23,7 +24,7 @@ from ignjax.evaluate import metrics as M
 from ignjax.evaluate.outcomes import (metric_rows, model_totals, outcome_rows, write_metric_table, write_outcomes,
                                       write_trajectories)
 from ignjax.fileio import atomic_write
-from ignjax.protocol import BIN_INDEX, BIN_NAMES, FACTOR_NAMES, SUCCESS_THRESHOLDS
+from ignjax.protocol import BIN_INDEX, BIN_NAMES, FACTOR_NAMES
 from ignjax.scenes.viz.mapplot import plot_scene_map, save_figure
 from ignjax.studies import cost_derivation as C
 from ignjax.studies import cost_sensitivity as CS
@@ -137,7 +138,8 @@ def study_costs(es, rollouts: dict, in_loop: dict | None, cfg: SweepConfig, out:
     for a, name in enumerate(res["agent_names"]):
         rows.append([name, ranked[0, a], ranked[1, a], float(np.mean(ranked[:, a])), float(np.min(ranked[:, a])),
                      float(np.max(ranked[:, a])), int(res["reference_ranks"][a]), float(np.mean(res["ranks"][:, a]))])
-    header = ["agent", "WSR locked", "WSR uniform", "WSR mean", "WSR min", "WSR max", "rank locked", "mean rank"]
+    header = ["agent", "WSR charged costs", "WSR equal costs", "WSR mean", "WSR min", "WSR max", "rank (charged costs)",
+              "mean rank"]
     write_csv(out / "costs_offline.csv", header, rows)
     summary = {"offline": res, "offline_table": (header, rows)}
     if in_loop is not None:
@@ -268,10 +270,18 @@ def study_analysis(es, rollouts: dict, cfg: SweepConfig, out: Path) -> dict:
     IA.plot_location_classes(loc, fig / "analysis_type3_locations.png", content=content)
     IA.plot_questions_per_difficulty(qpd, fig / "analysis_questions_per_difficulty.png")
     IA.plot_delta_u(du, fig / "analysis_delta_u.png")
+    kept = np.isfinite(du["delta_u"])
+
+    def bin_mean(values, b):  # mean over the bin's counted questions (nan when none)
+        m = kept & (du["difficulty"] == b)
+        return float(np.mean(values[m])) if m.any() else float("nan")
+
     rows = [[BIN_NAMES[b], float(qpd["mean_total"][b])] + [float(qpd["mean_per_type"][b, t]) for t in range(4)]
-            + [100 * float(du["mean"][b]) if np.isfinite(du["mean"][b]) else float("nan"), int(du["count"][b])]
+            + [100 * float(du["mean"][b]), 100 * float(du["median"][b]), bin_mean(du["area_before"], b),
+               bin_mean(du["area_after"], b), int(du["count"][b])]
             for b in range(3)]
-    header = ["difficulty", "|Q|", "Q1", "Q2", "Q3", "Q4", "Delta-U (%)", "Type-3 questions with a matched horizon"]
+    header = ["difficulty", "|Q|", "Q1", "Q2", "Q3", "Q4", "Delta-U mean (%)", "Delta-U median (%)", "A_before (m^2)",
+              "A_after (m^2)", "Type-3 questions counted"]
     write_csv(out / "analysis_per_difficulty.csv", header, rows)
     lheader = ["class", "Type-3 questions", "share"]
     lrows = [[c, int(n), float(f)] for c, n, f in zip(loc["classes"], loc["counts"], loc["fractions"])]
@@ -288,6 +298,7 @@ def study_analysis(es, rollouts: dict, cfg: SweepConfig, out: Path) -> dict:
         ctable = (cheader, crows)
     plots = plot_trajectories(es, tree, int(cfg.analysis.trajectories), fig, agent)
     return {"agent": agent, "per_difficulty": (header, rows), "locations": (lheader, lrows), "timing": timing,
+            "delta_u": du,
             "content": content, "content_table": ctable, "trajectory_plots": plots}
 
 
@@ -343,198 +354,5 @@ def plot_trajectories(es, tree: dict, n: int, folder: Path, agent: str) -> list[
     return paths
 
 
-# ---------------------------------------------------------------------------
-# report
-# ---------------------------------------------------------------------------
-
-
-def _section_eval(results: dict, es, rollouts: dict, cfg, out: Path) -> list[str]:
-    ev = study_eval(es, rollouts, cfg, out)
-    results["eval"] = ev
-    parts = ["## Evaluation (Table-1 columns)", "",
-             "SR/OSR and WSR in %, NE and TL in metres, Q_t questions per episode; the Easy/Medium/Hard columns "
-             "repeat SR@1.5, WSR@1.5 and |Q| per difficulty. `shortest_path` is privileged (an upper bound).", ""]
-    if all(t in cfg.eval.thresholds for t in SUCCESS_THRESHOLDS):
-        parts += [M.table1(ev["metrics"], "markdown"), ""]
-    parts += ["Per-episode outcomes: `outcomes.parquet`, `outcomes.csv`; metrics: `metrics.csv`; per-step "
-              "trajectories: `trajectories.npz`.", "",
-              f"Episode viewer: [{VIEWER_FILE}]({VIEWER_FILE}) (one self-contained page: every episode of every "
-              "agent, sortable and filterable, replayed step by step on the map with the oracle's answers; "
-              "`python -m ignjax.view RUN_DIR` (this folder) rebuilds it, `--gif EPISODE_ID --agent NAME` exports "
-              "one episode as an animation).", ""]
-    if ev["model_totals"]:
-        parts += ["MLLM agents' model calls (requests: every attempt sent to the server, answered or not, cache hits "
-                  "excluded; tokens as the server counted them; refused asks: questions asked with none left, "
-                  "corrected; cost from `llm.prices`); per-decision transcripts in `transcripts/<agent>.jsonl`:",
-                  "", "| agent | requests | cache hits | prompt tokens | completion tokens | retries | invalid replies "
-                  "| refused asks | ended by model failure | cost (USD) |", "|---|---|---|---|---|---|---|---|---|---|"]
-        for name, t in ev["model_totals"].items():
-            cost = "" if t["cost_usd"] is None else f"{t['cost_usd']:.4f}"
-            parts.append(f"| {name} | {t['requests']} | {t['cache_hits']} | {t['prompt_tokens']} | "
-                         f"{t['completion_tokens']} | {t['retries']} | {t['invalid_replies']} | {t['refused_asks']} | "
-                         f"{t['failures']} | {cost} |")
-        parts += ["", "Per episode (mean / max over the agent's episodes; model calls sent or answered from the cache, "
-                  "whose tokens and cost count alike; per-episode figures also in the outcome table's `requests`, "
-                  "`cache_hits`, `prompt_tokens`, `completion_tokens` and `cost_usd` columns):", "",
-                  "| agent | episodes | model calls | prompt tokens | completion tokens | cost (USD) |",
-                  "|---|---|---|---|---|---|"]
-        for name, t in ev["model_totals"].items():
-            pe = t["per_episode"]
-            cost = "" if pe["cost_usd"] is None else f"{pe['cost_usd']['mean']:.6f} / {pe['cost_usd']['max']:.6f}"
-            parts.append(f"| {name} | {t['episodes']} | {pe['calls']['mean']:.1f} / {pe['calls']['max']} | "
-                         f"{pe['prompt_tokens']['mean']:.0f} / {pe['prompt_tokens']['max']} | "
-                         f"{pe['completion_tokens']['mean']:.0f} / {pe['completion_tokens']['max']} | {cost} |")
-        parts.append("")
-        if cfg.llm.paraphrase:
-            parts += ["Oracle answers were reworded by the model before the agents read them (`llm.paraphrase`; "
-                      "transcript role `paraphrase`); rewordings refused by the leak checks, the template shown "
-                      "instead: " + ", ".join(f"{name} {t['paraphrase_rejected']}"
-                                             for name, t in ev["model_totals"].items()) + ".", ""]
-        naive = [n for n in ev["model_totals"] if n.endswith("-naive")]
-        if cfg.llm.naive_unbudgeted and naive:
-            parts += [f"The naive-QA rows ({', '.join(naive)}) ran with no question budget (`llm.naive_unbudgeted`: "
-                      "the reading of the paper's naive rows, README \"Reading the paper's tables\"); every other "
-                      "agent kept the budget.", ""]
-    return parts
-
-
-def _section_costs(results: dict, es, rollouts: dict, cfg, out: Path) -> list[str]:
-    parts: list[str] = []
-    cs = study_costs(es, rollouts, results.get("in_loop"), cfg, out)
-    results["costs"] = cs
-    res = cs["offline"]
-    fl = res["flips"]
-    parts += ["## Cost-weight sensitivity", "",
-              f"Offline: the stored outcomes re-weighted under {len(res['costs'])} cost vectors (row 0 locked, "
-              f"row 1 uniform, the rest uniform on the simplex scaled to the locked sum). WSR@1.5 in %.", "",
-              M.md_table(cs["offline_table"][0], [[r[0]] + [100 * v if i < 5 else v for i, v in enumerate(r[1:])]
-                                                for r in cs["offline_table"][1]]), "",
-              f"The ranking differs from the locked-cost ranking for {100 * fl['fraction_flipped']:.1f}% of the "
-              f"cost vectors (mean Kendall tau {fl['tau_mean']:.3f}, min {fl['tau_min']:.3f}). Mean costs where "
-              f"rankings flip: {np.round(fl['mean_costs_flipped'], 3).tolist()}; where they hold: "
-              f"{np.round(fl['mean_costs_kept'], 3).tolist()}.", "",
-              "![WSR against each type's cost](figures/costs_marginal_wsr.png)", "",
-              "![Where rankings flip](figures/costs_flip_map.png)", ""]
-    if "in_loop_table" in cs:
-        h, rows = cs["in_loop_table"]
-        parts += [f"In the loop: `{cs['in_loop_agent']}` re-run under each charged cost vector (one vmapped call "
-                  "over cost vectors x episodes). Its asking should fall as costs rise.", "",
-                  M.md_table(h, rows), "", "![Asking vs costs](figures/costs_in_loop.png)", ""]
-    return parts
-
-
-def _section_difficulty(results: dict, es, rollouts: dict, cfg, out: Path) -> list[str]:
-    ds = study_difficulty(es, rollouts, cfg, out)
-    results["difficulty"] = ds
-    abl = ds["ablation"]
-    p = ds["default_proportions"]
-    parts = ["## Difficulty-coefficient ablation", "",
-             f"{len(abl['alphas'])} alpha settings on the simplex x {len(abl['thresholds'])} threshold pairs "
-             f"({ds['n_settings']} settings), on the stored factors. Per-bin SR is ordered easy >= medium >= hard "
-             f"for every agent in {100 * abl['fraction_ordered']:.1f}% of the settings "
-             f"(empty-bin rule: {cfg.difficulty.empty}). The reference alpha {tuple(cfg.difficulty.alpha)} and "
-             f"thresholds {tuple(cfg.difficulty.thresholds)} give bins "
-             f"{100 * p[0]:.0f}/{100 * p[1]:.0f}/{100 * p[2]:.0f}% of the episodes.", "",
-             M.md_table(*ds["default_bins"]), "", "![Ordering](figures/difficulty_ordering.png)", "",
-             "Calibration (alpha maximising the Spearman correlation between D and failure, mean over agents; "
-             "fitted on one half of the episodes, reported on the other):", "",
-             M.md_table(*ds["calibration_table"]), "", "![Calibration](figures/difficulty_calibration.png)", ""]
-    return parts
-
-
-def _section_derive_costs(results: dict, es, rollouts: dict, cfg, out: Path) -> list[str]:
-    dc = study_derive_costs(cfg, out)
-    results["derive-costs"] = dc
-    parts = ["## Cost derivation", "",
-             f"Cue statistics -> U_c = l_s s_c + l_h h_c + l_r r_c -> mention-weighted U_t -> linear rescale into "
-             f"the locked penalty range. Input: {dc['source']}."
-             + (f" Cues with assumed statistics (unpublished): {', '.join(map(str, dc['assumed']))}."
-               if dc["assumed"] else ""), "",
-             M.md_table(*dc["table"]), ""]
-    return parts
-
-
-def _section_analysis(results: dict, es, rollouts: dict, cfg, out: Path) -> list[str]:
-    an = study_analysis(es, rollouts, cfg, out)
-    results["analysis"] = an
-    parts = [f"## Interaction analyses (`{an['agent']}`)", "",
-             M.md_table(*an["per_difficulty"]), "",
-             "Where Type-3 questions were asked (classified from the navigation grid):", "",
-             M.md_table(*an["locations"]), ""]
-    if an["content_table"] is not None:
-        h, rows = an["content_table"]
-        parts += ["What Type-3 questions asked, classified from the question text the agent wrote (rules in "
-                  "`ignjax.studies.interaction`; shares of classified in the paper: route 10%, goal-room position "
-                  "65%, room relations 25%), in `analysis_type3_content.csv`:", "",
-                  M.md_table(h, [[r[0], r[1]] + [f"{100 * v:.1f}%" if math.isfinite(v) else "" for v in r[2:]]
-                                 for r in rows]), ""]
-    else:
-        parts += [f"What Type-3 questions asked (route / goal-room position / room relations): not applicable, "
-                  f"{an['content']['reason']}.", ""]
-    parts += ["![Timing](figures/analysis_timing.png)", "",
-              "![Type-3 locations and content](figures/analysis_type3_locations.png)", "",
-              "![Questions per difficulty](figures/analysis_questions_per_difficulty.png)", "",
-              "![Delta-U](figures/analysis_delta_u.png)", ""]
-    for p in an["trajectory_plots"]:
-        parts += [f"![trajectory]({p.relative_to(out).as_posix()})", ""]
-    return parts
-
-
-SECTIONS = MappingProxyType({
-    "eval": _section_eval,
-    "costs": _section_costs,
-    "difficulty": _section_difficulty,
-    "derive-costs": _section_derive_costs,
-    "analysis": _section_analysis,
-})
-"""Study name -> its report section: runs the study's tables and figures on
-the sweep's results and returns the section's markdown lines. The order is
-the report's (and :data:`ignjax.sweep.cli.STUDIES`', which lists the same
-names without importing the studies). A new study is one module in
-:mod:`ignjax.studies` plus one entry here and in ``STUDIES``."""
-
-
-def _settings(values: dict) -> str:
-    return ", ".join(f"{k}={list(v) if isinstance(v, tuple) else v}" for k, v in values.items())
-
-
-def settings_lines(sim: dict, agents: dict[str, dict]) -> list[str]:
-    """Markdown lines stating the simulator settings and every agent's parameters used (report headers)."""
-    lines = [f"- Simulator: {_settings(sim)}."]
-    lines += [f"- Agent `{name}`: {_settings(values) or 'no parameters'}." for name, values in agents.items()]
-    return lines
-
-
-def mllm_settings_line(cfg: SweepConfig) -> str:
-    """The report header's line on what the MLLM agents were sent: the model, its decoding settings and the
-    image size (``views.size``)."""
-    llm, views = cfg.llm, cfg.views
-    return (f"- MLLM agents: model `{llm.model}`, temperature {llm.temperature:g}, max_tokens {llm.max_tokens}, "
-            f"seed {llm.seed}; views of {views.size} x {views.size} px (`views.size`), {views.image_format}.")
-
-
-def write_outputs(results: dict, out: Path) -> None:
-    """Run the table-and-figure part of each study in ``results["studies"]`` and write ``report.md``."""
-    cfg, studies = results["config"], results["studies"]
-    es = results.get("episodes")
-    rollouts = results.get("rollouts", {})
-    parts = [f"# ignjax sweep: {cfg.run.name}", ""]
-    if es is not None:
-        counts = {b: sum(r["difficulty"] == b for r in es.records) for b in BIN_NAMES}
-        parts += [f"Benchmark: {len(es)} episodes in {len(es.bank.scene_ids)} scenes "
-                  f"({', '.join(f'{counts[b]} {b}' for b in BIN_NAMES)}); seed {cfg.run.seed}; "
-                  f"costs charged (and planned with) {tuple(cfg.eval.costs)}; {M.success_rule(cfg.eval.require_stop)}.",
-                  ""]
-        agents = list(dict.fromkeys(list(cfg.eval.agents) + ([cfg.analysis.agent] if "analysis" in studies else [])))
-        parts += settings_lines(cfg.to_dict()["sim"], cfg.agents.used(agents))
-        parts += [mllm_settings_line(cfg)] if any(a in LLM_AGENTS for a in agents) else []
-        parts += [""]
-    for name, section in SECTIONS.items():
-        if name in studies:
-            parts += section(results, es, rollouts, cfg, out)
-    atomic_write(out / "report.md", "\n".join(parts))
-
-
-__all__ = ["SECTIONS", "VIEWER_FILE", "settings_lines", "agent_arrays", "factors_of", "in_loop_costs", "mllm_settings_line",
-           "plot_trajectories", "question_content", "study_analysis", "study_costs",
-           "study_derive_costs", "study_difficulty", "study_eval", "write_csv", "write_outputs"]
+__all__ = ["VIEWER_FILE", "agent_arrays", "factors_of", "in_loop_costs", "plot_trajectories", "question_content",
+           "study_analysis", "study_costs", "study_derive_costs", "study_difficulty", "study_eval", "write_csv"]

@@ -1,7 +1,7 @@
 """The sweep's work: the benchmark it runs on, the rollout stages
 (evaluation per agent, the cost-aware agent in the loop), each checkpointed
 as it finishes, and :func:`run_sweep`, which runs them and then writes the
-report (:mod:`ignjax.sweep.report`).
+report (:mod:`ignjax.sweep.report`, :mod:`ignjax.sweep.sections`).
 
 An MLLM agent in ``eval.agents`` (``vlm``, ...) runs through the host loop
 (:func:`ignjax.evaluate.hostloop.run_llm_agent`) against the ``[llm]``
@@ -46,7 +46,8 @@ from ignjax.evaluate.runner import BucketPlan, agent_batches, batch_program, buc
 from ignjax.scenes.io.sources import scene_sources
 from ignjax.sim.rollout import batch_parts, compile_ahead, rollout_sweep
 from ignjax.sweep.checkpoints import Checkpoints, prepare_folder
-from ignjax.sweep.report import in_loop_costs, write_outputs
+from ignjax.sweep.report import in_loop_costs
+from ignjax.sweep.sections import write_outputs
 
 
 

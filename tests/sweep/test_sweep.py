@@ -9,6 +9,7 @@ import dataclasses
 import json
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -116,9 +117,10 @@ def test_run_json_and_report_header_record_every_setting(sweep_run):
     assert set(config["agents"]) == set(registry())
     assert set(config["agents"]["eig"]) == set(param_values(registry()["eig"]))
     head = (out / "report.md").read_text().split("## ", 1)[0]
-    assert "success = final geodesic distance <= tau (the paper's Eq. wsr" in head
+    assert "success = final geodesic distance <= tau (the paper's rule" in head
     assert "- Simulator: max_steps=20, max_questions=10," in head and "question_budget=True" in head
-    assert "- Agent `eig`: threshold=" in head and "- Agent `random`: stop_prob=0.05" in head
+    assert "- Agent `eig`: cost-aware: " in head and "Parameters: threshold=2.5, " in head
+    assert "- Agent `random`: random moves" in head and "Parameters: stop_prob=0.05." in head
 
 
 def test_every_sim_field_and_agent_parameter_is_a_config_key():
@@ -380,7 +382,7 @@ def test_resume_deletes_what_a_killed_write_left_and_nothing_else(tmp_path):
 
 def test_every_study_has_one_report_section_in_the_same_order():
     from ignjax.sweep.cli import STUDIES
-    from ignjax.sweep.report import SECTIONS
+    from ignjax.sweep.sections import SECTIONS
 
     assert tuple(SECTIONS) == STUDIES
 
@@ -405,3 +407,81 @@ def test_sweep_in_buckets_gives_the_same_results(sweep_run, small_benchmark, tmp
     chex.assert_trees_all_equal(res["in_loop"], one["in_loop"])
     assert (out / "costs_in_loop.csv").read_bytes() == (sweep_run["out"] / "costs_in_loop.csv").read_bytes()
     assert json.loads((out / "run.json").read_text())["config"]["eval"]["bank_mb"] == pytest.approx(tight)
+
+
+# ---------------------------------------------------------------------------
+# the report's text: tables that render, captions, findings from the data
+# ---------------------------------------------------------------------------
+
+CELL_SPLIT = re.compile(r"(?<!\\)\|")
+
+
+def _cells(line: str) -> list[str]:
+    """A GFM table row's cells (an escaped pipe, ``\\|``, stays inside its cell)."""
+    return [c.strip() for c in CELL_SPLIT.split(line.strip())[1:-1]]
+
+
+def _tables(text: str) -> list[tuple[int, list[str]]]:
+    """(line index, lines) of every block of consecutive lines starting with ``|``."""
+    out, lines = [], text.splitlines()
+    i = 0
+    while i < len(lines):
+        if lines[i].startswith("|"):
+            j = i
+            while j < len(lines) and lines[j].startswith("|"):
+                j += 1
+            out.append((i, lines[i:j]))
+            i = j
+        else:
+            i += 1
+    return out
+
+
+def test_every_table_renders_with_a_reading(sweep_run):
+    """Every table in report.md is a GFM table: a header, a separator row of as many cells, every row with as
+    many cells as the header (escaped pipes kept inside cells), and a line of text before it."""
+    text = (sweep_run["out"] / "report.md").read_text()
+    lines = text.splitlines()
+    tables = _tables(text)
+    assert len(tables) >= 8
+    for start, rows in tables:
+        header = _cells(rows[0])
+        assert len(rows) >= 3 and all(re.fullmatch(r":?-{3,}:?", c) for c in _cells(rows[1])), rows[:2]
+        for row in rows[1:]:
+            assert len(_cells(row)) == len(header), (rows[0], row)
+        before = [line for line in lines[:start] if line.strip()]
+        assert before and not before[-1].startswith(("|", "#", "!")), rows[0]
+    assert "| Agent | Easy SR@1.5 | Easy \\|Q\\| |" in text  # the |Q| columns are escaped at the source
+
+
+def test_every_figure_has_a_caption_and_its_own_alt_text(sweep_run):
+    lines = (sweep_run["out"] / "report.md").read_text().splitlines()
+    figures = [(i, re.fullmatch(r"!\[(.+)\]\((.+)\)", line)) for i, line in enumerate(lines) if line.startswith("![")]
+    assert len(figures) >= 10 and all(m for _, m in figures)
+    alts = [m.group(1) for _, m in figures]
+    assert len(set(alts)) == len(alts), alts
+    for i, m in figures:
+        caption = next(line for line in lines[i + 1:] if line.strip())
+        assert caption.startswith("*") and caption.endswith("*") and len(caption) > 40, (m.group(2), caption)
+
+
+def test_sections_open_with_findings_from_the_data(sweep_run):
+    """The evaluation's first sentence names the agent metrics.csv shows as best on SR@1.5; the in-the-loop
+    finding quotes the table's first and last |Q|; every section's first line is a sentence, not a table."""
+    out = sweep_run["out"]
+    text = (out / "report.md").read_text()
+    with open(out / "metrics.csv") as fh:
+        metrics = {r["agent"]: r for r in csv.DictReader(fh)}
+    best = max(metrics, key=lambda a: float(metrics[a]["SR@1.5"]))
+    body = {s.split("\n", 1)[0]: s.split("\n", 1)[1] for s in text.split("\n## ")[1:]}
+    first = {k: next(line for line in v.splitlines() if line.strip()) for k, v in body.items()}
+    assert first["Evaluation (Table-1 columns)"].startswith(f"`{best}` has")
+    assert f"({float(metrics[best]['SR@1.5']):.1f}%)" in first["Evaluation (Table-1 columns)"]
+    for name, line in first.items():
+        assert line[0] not in "|!" and line.endswith("."), (name, line)
+    h, rows = sweep_run["res"]["costs"]["in_loop_table"]
+    assert f"asks {rows[0][h.index('|Q|')]:.2f} questions per episode at x0.25" in text
+    head = text.split("## ", 1)[0]
+    random_line = [line for line in head.splitlines() if line.startswith("- Agent `random`")]
+    assert random_line and "stop_prob" in random_line[0]
+    assert "Eq. wsr" not in text and "row 0 locked" not in text and "F_distractor" not in text

@@ -104,7 +104,8 @@ def test_sweep_eval_runs_an_mllm_agent_and_reruns_from_the_cache(rendering, tmp_
         assert (f"| vlm | 3 | {mean[0]:.1f} / {max(x[0] for x in each)} | {mean[1]:.0f} / {max(x[1] for x in each)} | "
                 f"{mean[2]:.0f} / {max(x[2] for x in each)} | {sum(costs) / 3:.6f} / {max(costs):.6f} |") in report
         # the agents' options are stated in the report header; the interaction analyses ran on the MLLM agent's traces
-        assert "- Agent `vlm`: observation=panel" in report and "- Agent `tandem-naive`:" in report
+        vlm = next(line for line in report.splitlines() if line.startswith("- Agent `vlm`: "))
+        assert "Parameters: observation=panel" in vlm and "- Agent `tandem-naive`:" in report
         # what the MLLM agents were sent: the paper's decoding settings and the views' size, in the report and run.json
         assert (f"- MLLM agents: model `{srv.model}`, temperature 0, max_tokens 1024, seed 0; views of 64 x 64 px "
                 "(`views.size`), jpeg.") in report
