@@ -43,6 +43,7 @@ def question_timing_figure(result: dict, title: str | None = None):
     ax.grid(alpha=0.3)
     _legend_right(ax)
     ax.set_title(title or "When questions are asked", fontsize=10)
+    fig.tight_layout()
     return fig
 
 
@@ -88,6 +89,7 @@ def location_classes_figure(result: dict, title: str | None = None, content: dic
     elif content is not None:
         fig.text(0.01, 0.01, f"What Type-3 questions asked: not applicable, {content['reason']}.", fontsize=7,
                  color="0.3", ha="left", va="bottom")
+    fig.tight_layout()
     return fig
 
 
@@ -130,6 +132,7 @@ def questions_per_difficulty_figure(result: dict, title: str | None = None):
     ax.grid(alpha=0.3, axis="y")
     _legend_right(ax)
     ax.set_title(title or "Questions by difficulty", fontsize=10)
+    fig.tight_layout()
     return fig
 
 
@@ -167,6 +170,7 @@ def delta_u_figure(result: dict, title: str | None = None):
     ax.grid(alpha=0.3, axis="y")
     ax.set_title(title or f"ΔU per Type-3 question: explored area before vs. after the answer\n(mean and 95 % "
                           f"interval; h={result['h']} steps, r={result['r']:g} m)", fontsize=10)
+    fig.tight_layout()
     return fig
 
 

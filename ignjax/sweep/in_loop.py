@@ -119,6 +119,7 @@ def in_loop_figure(runs: InLoopRuns):
     _legend_right(ax)
     if per_type:
         _per_type_panels(axs[1, 0], axs[1, 1], runs, n_s)
+    fig.tight_layout()
     return fig
 
 

@@ -56,6 +56,7 @@ class AgentPath:
         success: the episode succeeded (at ``threshold``).
         final_distance: the final distance to the target, m.
         threshold: the success threshold, m.
+        n_questions: the questions charged (the outcome's count: a refused question is marked but not counted).
     """
 
     agent: str
@@ -64,10 +65,7 @@ class AgentPath:
     success: bool
     final_distance: float
     threshold: float
-
-    @property
-    def n_questions(self) -> int:
-        return int((np.asarray(self.questions) > 0).sum())
+    n_questions: int
 
 
 def pick_episodes(difficulties, houses, n: int, seed: int) -> list[int]:
@@ -187,12 +185,13 @@ def _mappable(norm: Normalize):
 
 def agent_paths(tree: dict, index: int, agent: str, success: bool, threshold: float) -> AgentPath:
     """Episode ``index`` of one agent's rollout (``tree``: ``traj`` with ``pose``, ``kind``, ``question``;
-    ``out`` with ``final_distance``)."""
+    ``out`` with ``final_distance`` and ``n_questions``)."""
     kind = np.asarray(tree["traj"]["kind"][index])
     used = int((kind >= 0).sum())
     pose = np.asarray(tree["traj"]["pose"][index])
     return AgentPath(agent, pose[: used + 1, :2], np.asarray(tree["traj"]["question"][index])[:used], bool(success),
-                     float(np.asarray(tree["out"]["final_distance"])[index]), float(threshold))
+                     float(np.asarray(tree["out"]["final_distance"])[index]), float(threshold),
+                     int(np.asarray(tree["out"]["n_questions"])[index].sum()))
 
 
 def plot_trajectories(es, rollouts: dict, success: dict, n: int, folder: Path, seed: int,
