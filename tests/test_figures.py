@@ -261,7 +261,7 @@ def test_statistics_figure_bars_side_by_side(tmp_path):
     rng = np.random.default_rng(0)
 
     def summary(n):
-        return {"per_bin": {"easy": n // 3, "medium": n // 3, "hard": n - 2 * (n // 3)},
+        return {"episodes": n, "per_bin": {"easy": n // 3, "medium": n // 3, "hard": n - 2 * (n // 3)},
                 "distractors": {"values": rng.integers(0, 6, n).tolist()},
                 "difficulty_score": {"values": rng.random(n).tolist()},
                 "start_distance": {"values": (3 + 10 * rng.random(n)).tolist()},
@@ -269,12 +269,15 @@ def test_statistics_figure_bars_side_by_side(tmp_path):
 
     fig = statistics_figure(summary(90), summary(30), tmp_path / "stats.png")
     assert (tmp_path / "stats.png").read_bytes()[:8] == PNG
+    [legend] = fig.legends  # one legend for every panel, above them
+    assert _labels(legend) == ["corpus (90 episodes)", "subset (30 episodes)"]
+    _assert_outside(fig, legend, fig.axes)
     for ax in fig.axes[1], fig.axes[2], fig.axes[4]:
         assert ax.get_ylabel() == "share of the set's episodes (%)"
         assert all(p.get_alpha() in (None, 1.0) for p in ax.patches)  # nothing translucent, no blended colour
         spans = sorted((round(p.get_x(), 9), round(p.get_x() + p.get_width(), 9)) for p in ax.patches)
         assert all(b[0] >= a[1] - 1e-9 for a, b in zip(spans, spans[1:]))  # no bar over another
-        assert [t.split(" (")[0] for t in _labels(ax.get_legend())] == ["corpus", "subset"]
+        assert ax.get_legend() is None
         sums = {}
         for p in ax.patches:
             sums[p.get_facecolor()] = sums.get(p.get_facecolor(), 0.0) + p.get_height()

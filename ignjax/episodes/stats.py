@@ -16,6 +16,7 @@ from collections import Counter
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.patches import Patch
 
 from ignjax.episodes.difficulty import FactorNorms
 from ignjax.protocol import BIN_NAMES
@@ -82,17 +83,16 @@ def _shares(ax, sets, key: str, edges, xlabel: str) -> None:
         v = np.asarray(s[key]["values"], np.float64)
         if len(v):
             counts = np.histogram(np.clip(v, edges[0], edges[-1]), bins=edges)[0]
-            ax.bar(edges[:-1] + width * j / k, 100 * counts / len(v), width / k, align="edge", color=col,
-                   label=f"{lab} ({len(v)} episodes)")
+            ax.bar(edges[:-1] + width * j / k, 100 * counts / len(v), width / k, align="edge", color=col, label=lab)
     ax.set_xlabel(xlabel)
     ax.set_ylabel("share of the set's episodes (%)")
-    ax.legend()
 
 
 def statistics_figure(corpus: dict, subset: dict | None, path: str | os.PathLike, title: str = "Benchmark statistics",
                       thresholds=(0.30, 0.60)):
     """Draw six panels (corpus in grey, subset in colour, bars side by side
-    in every bin: no blended colour) and write a PNG atomically."""
+    in every bin: no blended colour; one legend for all, above the panels)
+    and write a PNG atomically."""
     fig = Figure(figsize=(15, 8.5), dpi=110)
     axes = fig.subplots(2, 3)
     sets = [("corpus", corpus, "#9e9e9e")] + ([("subset", subset, "#1f77b4")] if subset else [])
@@ -105,7 +105,6 @@ def statistics_figure(corpus: dict, subset: dict | None, path: str | os.PathLike
     ax.set_xticks(range(3), BIN_NAMES)
     ax.set_ylabel("episodes")
     ax.set_title("(a) episodes per difficulty bin")
-    ax.legend()
 
     ax = axes[0, 1]
     top = max([int(np.max(s["distractors"]["values"], initial=0)) for _, s, _ in sets] + [0])
@@ -143,7 +142,10 @@ def statistics_figure(corpus: dict, subset: dict | None, path: str | os.PathLike
     ax.set_ylabel("episodes")
     ax.set_title(f"(f) goal-room labels, {sets[-1][0]}")
 
-    fig.suptitle(title)
-    fig.tight_layout()
+    fig.suptitle(title, y=0.99)
+    handles = [Patch(color=col, label=f"{lab} ({s['episodes']} episodes)" if "episodes" in s else lab)
+               for lab, s, col in sets]
+    fig.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0.965), ncol=len(sets), frameon=False)
+    fig.tight_layout(rect=(0, 0, 1, 0.93))
     save_figure(fig, path, 110)
     return fig
