@@ -59,8 +59,8 @@ def location_classes_figure(result: dict, title: str | None = None, content: dic
     all planner steps spent there (``steps``: :func:`~ignjax.studies.interaction.step_locations`,
     the base rate), and, with an applicable ``content``
     (:func:`~ignjax.studies.interaction.type3_content`), a second panel with
-    the share per content class. A content split that does not apply is a
-    note under the axes, not an empty panel."""
+    the share per content class. A content split that does not apply draws
+    nothing (the report's text says why), not an empty panel."""
     panel = content is not None and content["applicable"]
     fig, axs = new_figure(1, 2 if panel else 1, size=(12.5 if panel else 7.5, 4.2))
     ax = axs[0, 0]
@@ -86,9 +86,6 @@ def location_classes_figure(result: dict, title: str | None = None, content: dic
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.22), fontsize=8, frameon=False, ncol=1)
     if panel:
         _content_panel(axs[0, 1], content)
-    elif content is not None:
-        fig.text(0.01, 0.01, f"What Type-3 questions asked: not applicable, {content['reason']}.", fontsize=7,
-                 color="0.3", ha="left", va="bottom")
     fig.tight_layout()
     return fig
 

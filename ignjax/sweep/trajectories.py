@@ -131,7 +131,7 @@ def _draw_goal(ax, scene, target_id: str) -> None:
 
 def legend_handles() -> list:
     """The marks of a trajectory figure, for its legend."""
-    h = [Line2D([], [], color=TIME_CMAP(0.6), lw=2.2, label="path (colour: planner step)"),
+    h = [Line2D([], [], color=TIME_CMAP(0.6), lw=2.2, label="path: planner-step poses joined (colour: step)"),
          Line2D([], [], marker="o", ms=9, mfc="white", mec="black", mew=1.5, ls="none", label="start"),
          Line2D([], [], marker="s", ms=10, mfc="none", mec="black", mew=1.8, ls="none", label="end (final pose)"),
          Line2D([], [], marker="*", ms=17, color="gold", mec="black", ls="none", label="target"),

@@ -58,6 +58,10 @@ def test_map_png_is_written_for_a_generated_house(house, tmp_path):
     legend = [t.get_text() for t in ax.get_legend().get_texts()]
     for family in {category_family(c) for c in house.categories()}:  # one entry per family, with its count
         assert any(t.startswith(FAMILY_NAMES[family] + " (") for t in legend), family
+    fig.canvas.draw()
+    box = ax.get_legend().get_window_extent(fig.canvas.get_renderer())
+    assert fig.bbox.x0 <= box.x0 and box.x1 <= fig.bbox.x1 + 0.5  # right of the map, not cut by the figure's edge
+    assert box.x0 >= ax.get_window_extent().x1
 
 
 def test_existing_file_is_replaced_atomically(house, tmp_path):

@@ -62,7 +62,7 @@ FAMILY_NAMES: Mapping[str, str] = {
     "storage": "storage and beds",
     "appliances": "appliances",
     "electronics": "electronics",
-    "fixtures": "bath and heating fixtures",
+    "fixtures": "bath and heating",
     "wall": "wall-hung",
     "floor": "floor items",
     "small": "small objects",
@@ -200,7 +200,7 @@ def plot_scene_map(
         lo, hi = scene.bounds()
         w, h = max(float(hi[0] - lo[0]), 1.0), max(float(hi[1] - lo[1]), 1.0)
         scale = 9.0 / max(w, h)
-        extra = 2.6 if legend else 0.6
+        extra = 2.8 if legend else 0.6
         fig = Figure(figsize=(max(4.0, w * scale) + extra, max(3.5, h * scale) + 0.8))
         FigureCanvasAgg(fig)
         ax = fig.add_subplot(1, 1, 1)
