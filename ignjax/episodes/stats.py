@@ -10,11 +10,13 @@ rooms), for the whole corpus and the evaluation subset side by side.
 
 from __future__ import annotations
 
+import math
 import os
 from collections import Counter
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.patches import Patch
 
 from ignjax.episodes.difficulty import FactorNorms
 from ignjax.protocol import BIN_NAMES
@@ -73,9 +75,24 @@ def format_summary(name: str, s: dict, top: int = 10) -> str:
     return "\n".join(lines)
 
 
+def _shares(ax, sets, key: str, edges, xlabel: str) -> None:
+    """One histogram per set as side-by-side bars in each bin, each set's bars summing to 100 %."""
+    width = np.diff(edges)
+    k = len(sets)
+    for j, (lab, s, col) in enumerate(sets):
+        v = np.asarray(s[key]["values"], np.float64)
+        if len(v):
+            counts = np.histogram(np.clip(v, edges[0], edges[-1]), bins=edges)[0]
+            ax.bar(edges[:-1] + width * j / k, 100 * counts / len(v), width / k, align="edge", color=col, label=lab)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("share of the set's episodes (%)")
+
+
 def statistics_figure(corpus: dict, subset: dict | None, path: str | os.PathLike, title: str = "Benchmark statistics",
                       thresholds=(0.30, 0.60)):
-    """Draw six panels (corpus in grey, subset in colour) and write a PNG atomically."""
+    """Draw six panels (corpus in grey, subset in colour, bars side by side
+    in every bin: no blended colour; one legend for all, above the panels)
+    and write a PNG atomically."""
     fig = Figure(figsize=(15, 8.5), dpi=110)
     axes = fig.subplots(2, 3)
     sets = [("corpus", corpus, "#9e9e9e")] + ([("subset", subset, "#1f77b4")] if subset else [])
@@ -88,56 +105,47 @@ def statistics_figure(corpus: dict, subset: dict | None, path: str | os.PathLike
     ax.set_xticks(range(3), BIN_NAMES)
     ax.set_ylabel("episodes")
     ax.set_title("(a) episodes per difficulty bin")
-    ax.legend()
 
     ax = axes[0, 1]
-    for lab, s, col in sets:
-        v = np.asarray(s["distractors"]["values"])
-        if len(v):
-            ax.hist(v, bins=np.arange(v.max() + 2) - 0.5, density=True, alpha=0.6, color=col, label=lab)
-    ax.set_xlabel("same-category distractors in the scene")
-    ax.set_ylabel("share of episodes")
+    top = max([int(np.max(s["distractors"]["values"], initial=0)) for _, s, _ in sets] + [0])
+    _shares(ax, sets, "distractors", np.arange(top + 2) - 0.5, "same-category distractors in the scene")
     ax.set_title("(b) distractors per episode")
-    ax.legend()
 
     ax = axes[0, 2]
-    for lab, s, col in sets:
-        v = np.asarray(s["difficulty_score"]["values"])
-        if len(v):
-            ax.hist(v, bins=np.linspace(0, 1, 26), density=True, alpha=0.6, color=col, label=lab)
+    _shares(ax, sets, "difficulty_score", np.linspace(0, 1, 21), "difficulty score D")
     for t in thresholds:
         ax.axvline(t, color="k", lw=1, ls="--")
-    ax.set_xlabel("difficulty score D")
-    ax.set_ylabel("density")
-    ax.set_title("(c) difficulty scores and bin thresholds")
-    ax.legend()
+    ax.text(thresholds[0], 1.0, " easy | medium", transform=ax.get_xaxis_transform(), va="top", ha="center",
+            fontsize=8)
+    ax.text(thresholds[1], 1.0, " medium | hard", transform=ax.get_xaxis_transform(), va="top", ha="center",
+            fontsize=8)
+    ax.set_title("(c) difficulty scores and bin thresholds (dashed)", pad=14)
 
     ax = axes[1, 0]
     base = subset or corpus
     cats = list(base["per_category"].items())[:20]
     ax.barh([c.replace("_", " ") for c, _ in cats][::-1], [n for _, n in cats][::-1], color=sets[-1][2])
     ax.set_xlabel("episodes")
-    ax.set_title(f"(d) top target categories ({len(base['per_category'])} in all)")
+    ax.set_title(f"(d) top target categories, {sets[-1][0]} ({len(base['per_category'])} in all)")
     ax.tick_params(axis="y", labelsize=7)
 
     ax = axes[1, 1]
-    for lab, s, col in sets:
-        v = np.asarray(s["start_distance"]["values"])
-        if len(v):
-            ax.hist(v, bins=25, density=True, alpha=0.6, color=col, label=lab)
-    ax.set_xlabel("geodesic start-to-target distance (m)")
-    ax.set_ylabel("density")
+    far = max([float(np.max(s["start_distance"]["values"], initial=0.0)) for _, s, _ in sets] + [1.0])
+    _shares(ax, sets, "start_distance", np.arange(0.0, math.ceil(far) + 1.0, 1.0),
+            "geodesic start-to-target distance (m)")
     ax.set_title("(e) start distance")
-    ax.legend()
 
     ax = axes[1, 2]
     rooms = list(base["per_room"].items())
     ax.bar(range(len(rooms)), [n for _, n in rooms], color=sets[-1][2])
     ax.set_xticks(range(len(rooms)), [r.replace("_", " ") for r, _ in rooms], rotation=45, ha="right", fontsize=8)
     ax.set_ylabel("episodes")
-    ax.set_title("(f) goal-room labels")
+    ax.set_title(f"(f) goal-room labels, {sets[-1][0]}")
 
-    fig.suptitle(title)
-    fig.tight_layout()
+    fig.suptitle(title, y=0.99)
+    handles = [Patch(color=col, label=f"{lab} ({s['episodes']} episodes)" if "episodes" in s else lab)
+               for lab, s, col in sets]
+    fig.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0.965), ncol=len(sets), frameon=False)
+    fig.tight_layout(rect=(0, 0, 1, 0.93))
     save_figure(fig, path, 110)
     return fig

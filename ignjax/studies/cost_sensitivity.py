@@ -50,11 +50,15 @@ from functools import partial
 import jax
 import jax.numpy as jnp
 import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 
 from ignjax.evaluate import metrics as M
 from ignjax.studies.cost_derivation import simplex_grid
 from ignjax.errors import ConfigError, InputError
 from ignjax.protocol import LOCKED_COSTS, TYPE_LABELS
+from ignjax.scenes.viz.mapplot import save_figure
 from ignjax.studies._common import as_array, new_figure, save
 
 LOCKED = np.asarray(LOCKED_COSTS, dtype=np.float64)
@@ -410,7 +414,7 @@ def flip_regions(costs, tau, *, axes=(2, 3), bins: int = 20, tol: float = 1e-9) 
     }
 
 
-def marginal_curves(costs, wsr, bins: int = 20) -> dict:
+def marginal_curves(costs, wsr, bins: int = 20, se=None) -> dict:
     """Mean WSR of each agent as a function of each type's cost (averaging
     over the other types' costs among the sampled vectors).
 
@@ -418,10 +422,13 @@ def marginal_curves(costs, wsr, bins: int = 20) -> dict:
         costs: (K, 4).
         wsr: (K, A).
         bins: equal-width bins over each type's sampled cost range.
+        se: optional (K, A) standard error of each WSR over the episodes
+            (:func:`wsr_standard_error`).
 
     Returns:
         dict with ``edges`` (4, bins + 1), ``centers`` (4, bins), ``mean``
-        (4, bins, A) (NaN in empty bins), ``count`` (4, bins).
+        (4, bins, A) (NaN in empty bins), ``count`` (4, bins); with ``se``,
+        also ``se`` (4, bins, A): the bin's mean standard error.
     """
     c = validate_costs(costs).reshape(-1, 4)
     w = as_array(wsr, "wsr", ndim=2, dtype=np.float64)
@@ -430,6 +437,10 @@ def marginal_curves(costs, wsr, bins: int = 20) -> dict:
     edges = np.empty((4, bins + 1))
     mean = np.full((4, bins, w.shape[1]), np.nan)
     count = np.zeros((4, bins), np.int64)
+    e = None if se is None else as_array(se, "se", ndim=2, dtype=np.float64)
+    if e is not None and e.shape != w.shape:
+        raise InputError(None, "se", f"must have the shape of wsr {w.shape}, got {e.shape}")
+    mean_se = None if e is None else np.full_like(mean, np.nan)
     for t in range(4):
         lo, hi = float(c[:, t].min()), float(c[:, t].max())
         hi = hi if hi > lo else lo + 1e-12
@@ -439,7 +450,26 @@ def marginal_curves(costs, wsr, bins: int = 20) -> dict:
         sums = np.stack([np.bincount(idx, weights=w[:, a], minlength=bins) for a in range(w.shape[1])], -1)
         with np.errstate(invalid="ignore", divide="ignore"):
             mean[t] = np.where(count[t][:, None] > 0, sums / np.maximum(count[t], 1)[:, None], np.nan)
-    return {"edges": edges, "centers": (edges[:, 1:] + edges[:, :-1]) / 2, "mean": mean, "count": count}
+            if e is not None:
+                se_sums = np.stack([np.bincount(idx, weights=e[:, a], minlength=bins) for a in range(w.shape[1])], -1)
+                mean_se[t] = np.where(count[t][:, None] > 0, se_sums / np.maximum(count[t], 1)[:, None], np.nan)
+    out = {"edges": edges, "centers": (edges[:, 1:] + edges[:, :-1]) / 2, "mean": mean, "count": count}
+    if mean_se is not None:
+        out["se"] = mean_se
+    return out
+
+
+def wsr_standard_error(success, n_questions, valid, costs, wsr) -> np.ndarray:
+    """(K, A) standard error over the episodes of each WSR in ``wsr`` (K, A)
+    (success (A, E) at one threshold; the other arguments as
+    :func:`offline_wsr`). A WSR is the mean of ``success * exp(-w . n)``;
+    its second moment is the WSR under the doubled costs, since
+    ``exp(-w . n) ** 2 = exp(-2 w . n)`` and ``success ** 2 = success``."""
+    c = validate_costs(costs).reshape(-1, 4)
+    second = offline_wsr(success, n_questions, valid, 2.0 * c)
+    n = _episode_mask(valid, np.shape(success)[:2]).sum(1)  # (A,)
+    var = np.maximum(second - np.asarray(wsr, np.float64) ** 2, 0.0)
+    return np.sqrt(var / np.maximum(n - 1, 1))
 
 
 def run_study(success, n_questions, valid, costs, *, agent_names=None, threshold_index: int | None = None,
@@ -454,7 +484,9 @@ def run_study(success, n_questions, valid, costs, *, agent_names=None, threshold
 
     Returns:
         dict with ``agent_names``, ``costs`` (K, 4), ``wsr`` (K, A[, T]),
-        ``wsr_ranked`` (K, A) the WSR used for rankings, ``ranks`` (K, A),
+        ``wsr_ranked`` (K, A) the WSR used for rankings, ``wsr_se`` (K, A)
+        its standard error over the episodes (:func:`wsr_standard_error`),
+        ``asks`` (A,) whether the agent asked at all, ``ranks`` (K, A),
         ``reference_ranks`` (A,), ``tau`` (K,), ``flips``
         (:func:`flip_regions`), ``marginals`` (:func:`marginal_curves`),
         ``threshold_index``.
@@ -474,9 +506,13 @@ def run_study(success, n_questions, valid, costs, *, agent_names=None, threshold
         raise InputError(None, "agent_names", f"must name {A} agents, got {len(names)}")
     ranks = rankings(ranked)
     tau = kendall_tau(ranks, ranks[0])
-    return {"agent_names": names, "costs": c, "wsr": wsr, "wsr_ranked": ranked, "ranks": ranks,
+    s_ranked = as_array(success, "success")
+    s_ranked = s_ranked[..., ti] if s_ranked.ndim == 3 else s_ranked
+    se = wsr_standard_error(s_ranked, n_questions, valid, c, ranked)
+    return {"agent_names": names, "costs": c, "wsr": wsr, "wsr_ranked": ranked, "wsr_se": se, "ranks": ranks,
             "reference_ranks": ranks[0], "tau": tau, "flips": flip_regions(c, tau, axes=axes, bins=bins),
-            "marginals": marginal_curves(c, ranked, bins=bins), "threshold_index": ti}
+            "marginals": marginal_curves(c, ranked, bins=bins, se=se), "threshold_index": ti,
+            "asks": np.asarray(n_questions).sum((1, 2)) > 0}
 
 
 # ---------------------------------------------------------------------------
@@ -484,25 +520,58 @@ def run_study(success, n_questions, valid, costs, *, agent_names=None, threshold
 # ---------------------------------------------------------------------------
 
 
-def plot_marginal_wsr(result: dict, path: str | os.PathLike, title: str | None = None):
-    """Four panels (one per question type): mean WSR of each agent against
-    that type's cost, with the locked cost marked. ``result``: :func:`run_study`."""
+def marginal_wsr_figure(result: dict, title: str | None = None) -> Figure:
+    """Four panels (one per question type), one y scale: mean WSR of each
+    agent that asks against that type's cost, with a 95 % band over the
+    episodes and the locked cost marked. An agent that asks nothing has one
+    WSR whatever the costs: a dotted line when it falls in the range of the
+    others, else only its value in the legend (so the range where the
+    curves cross keeps the height). ``result``: :func:`run_study`."""
     m = result["marginals"]
     names = result["agent_names"]
-    fig, axs = new_figure(1, 4, size=(16.0, 3.8))
-    for t in range(4):
-        ax = axs[0, t]
+    asks = np.asarray(result.get("asks", np.ones(len(names), bool)), bool)
+    se = m.get("se", np.zeros_like(m["mean"]))
+    lo, hi = 100 * (m["mean"] - 1.96 * se), 100 * (m["mean"] + 1.96 * se)
+    if asks.any():
+        y0, y1 = float(np.nanmin(lo[..., asks])), float(np.nanmax(hi[..., asks]))
+    else:
+        y0, y1 = float(np.nanmin(100 * m["mean"])), float(np.nanmax(100 * m["mean"]))
+    pad = max(1.0, 0.08 * (y1 - y0))
+    y0, y1 = max(0.0, y0 - pad), min(100.0, y1 + pad)
+    fig = Figure(figsize=(16.0, 4.4), layout="constrained")
+    FigureCanvasAgg(fig)
+    axs = fig.subplots(1, 4, sharey=True)
+    colors = [f"C{a % 10}" for a in range(len(names))]
+    off_axis = []
+    for t, ax in enumerate(axs):
         for a, name in enumerate(names):
-            ax.plot(m["centers"][t], 100 * m["mean"][t, :, a], marker="o", ms=3, label=name)
+            x, y = m["centers"][t], 100 * m["mean"][t, :, a]
+            if asks[a]:
+                ax.plot(x, y, marker="o", ms=3, color=colors[a], label=f"{name} (band: 95 % interval)")
+                ax.fill_between(x, lo[t, :, a], hi[t, :, a], color=colors[a], alpha=0.2, lw=0)
+            else:
+                v = float(np.nanmean(y))
+                if y0 <= v <= y1:
+                    ax.axhline(v, color=colors[a], ls=":", lw=1.5, label=f"{name}: {v:.1f} % at every cost (asks nothing)")
+                elif t == 0:
+                    off_axis.append(Line2D([], [], color=colors[a], ls=":", lw=1.5,
+                                           label=f"{name}: {v:.1f} % at every cost (asks nothing; off the axis)"))
         ax.axvline(LOCKED[t], color="k", ls="--", lw=1, label="locked cost")
         ax.set_xlabel(f"cost w{t + 1} (penalty per question, unitless)")
-        ax.set_ylabel("mean WSR (%)")
         ax.set_title(TYPE_LABELS[t], fontsize=10)
         ax.grid(alpha=0.3)
-    axs[0, 0].legend(fontsize=7)
+    axs[0].set_ylim(y0, y1)
+    axs[0].set_ylabel("mean WSR over sampled cost vectors (%)")
+    fig.legend(handles=axs[0].get_legend_handles_labels()[0] + off_axis, loc="outside right upper", fontsize=8,
+               frameon=False)
     if title:
         fig.suptitle(title)
-    return save(fig, path)
+    return fig
+
+
+def plot_marginal_wsr(result: dict, path: str | os.PathLike, title: str | None = None):
+    """:func:`marginal_wsr_figure`, written as a PNG at ``path``; returns the path."""
+    return save_figure(marginal_wsr_figure(result, title), path, dpi=120)
 
 
 def plot_flip_map(result: dict, path: str | os.PathLike, title: str | None = None):
@@ -527,5 +596,6 @@ def plot_flip_map(result: dict, path: str | os.PathLike, title: str | None = Non
 
 
 __all__ = ["LOCKED", "LOCKED_SUM", "UNIFORM", "validate_costs", "cost_samples", "cost_grid", "offline_wsr", "rankings",
-           "kendall_tau", "share_projection", "flip_regions", "marginal_curves", "run_study", "plot_marginal_wsr",
+           "kendall_tau", "share_projection", "flip_regions", "marginal_curves", "run_study", "wsr_standard_error",
+           "marginal_wsr_figure", "plot_marginal_wsr",
            "plot_flip_map"]

@@ -128,7 +128,6 @@ Delta-U (:func:`delta_u`, paper §4.3)
 from __future__ import annotations
 
 import math
-import os
 import re
 from dataclasses import dataclass
 
@@ -137,9 +136,9 @@ from scipy import ndimage
 
 from ignjax.errors import ConfigError, InputError
 from ignjax.evaluate.outcomes import parse_trace
-from ignjax.protocol import BIN_NAMES, TYPE_LABELS
+from ignjax.protocol import BIN_NAMES
 from ignjax.scenes.vocab import ROOM_DISPLAY, ROOM_LABELS
-from ignjax.studies._common import as_array, new_figure, save
+from ignjax.studies._common import as_array
 
 LOCATION_CLASSES: tuple[str, ...] = ("corridor", "junction", "dead_end", "room")
 CORRIDOR, JUNCTION, DEAD_END, ROOM = range(4)
@@ -458,6 +457,39 @@ def classify_locations(grid, xy, params: LocationParams = LocationParams(), room
     return {"cls": cls.astype(np.int64), "lengths": lengths, "width": width, "sectors": sectors, "snapped": snapped}
 
 
+def _grid_lists(grids, n_episodes: int, scene_index, room_labels):
+    """(grids, room labels per grid, (E,) grid index per episode) of :func:`type3_locations`' arguments."""
+    if not isinstance(grids, (list, tuple)):
+        return [grids], [room_labels], np.zeros(n_episodes, np.int64)
+    glist = list(grids)
+    if scene_index is None:
+        raise InputError(None, "scene_index", "is required with several grids")
+    sidx = as_array(scene_index, "scene_index", ndim=1).astype(np.int64)
+    if sidx.shape[0] != n_episodes or sidx.min(initial=0) < 0 or sidx.max(initial=0) >= len(glist):
+        raise InputError(None, "scene_index", f"must give one grid index in 0..{len(glist) - 1} per episode")
+    labels = [None] * len(glist) if room_labels is None else list(room_labels)
+    if len(labels) != len(glist):
+        raise InputError(None, "room_labels", f"must hold one label sequence per grid ({len(glist)})")
+    return glist, labels, sidx
+
+
+def _classify_at(glist, labels, sidx, pz, ep, st, params, mask):
+    """(cls, width, sectors) of the poses ``pz[ep, st]``, each on its episode's grid; a position repeated
+    (turning or asking in place) is classified once."""
+    n = len(ep)
+    cls = np.full(n, UNKNOWN, np.int64)
+    width = np.full(n, np.nan)
+    sectors = np.zeros(n, np.int64)
+    xy = pz[ep, st, :2]
+    for g in np.unique(sidx[ep]) if n else []:
+        m = np.nonzero(sidx[ep] == g)[0]
+        points, back = np.unique(xy[m], axis=0, return_inverse=True)
+        r = classify_locations(glist[g], points, params, labels[g], mask)
+        back = back.reshape(-1)
+        cls[m], width[m], sectors[m] = r["cls"][back], r["width"][back], r["sectors"][back]
+    return cls, width, sectors
+
+
 def type3_locations(grids, poses, events: dict, *, scene_index=None, room_labels=None,
                     params: LocationParams = LocationParams(), mask="auto") -> dict:
     """Location class of every Type-3 question.
@@ -482,29 +514,8 @@ def type3_locations(grids, poses, events: dict, *, scene_index=None, room_labels
     ep, st = events["episode"][sel], events["step"][sel]
     if ep.size and (ep.max() >= pz.shape[0] or st.max() >= pz.shape[1]):
         raise InputError(None, "poses", f"shape {pz.shape} does not cover the events (episode {ep.max()}, step {st.max()})")
-    single = not isinstance(grids, (list, tuple))
-    glist = [grids] if single else list(grids)
-    if single:
-        sidx = np.zeros(pz.shape[0], np.int64)
-        labels = [room_labels]
-    else:
-        if scene_index is None:
-            raise InputError(None, "scene_index", "is required with several grids")
-        sidx = as_array(scene_index, "scene_index", ndim=1).astype(np.int64)
-        if sidx.shape[0] != pz.shape[0] or sidx.min(initial=0) < 0 or sidx.max(initial=0) >= len(glist):
-            raise InputError(None, "scene_index", f"must give one grid index in 0..{len(glist) - 1} per episode")
-        labels = [None] * len(glist) if room_labels is None else list(room_labels)
-        if len(labels) != len(glist):
-            raise InputError(None, "room_labels", f"must hold one label sequence per grid ({len(glist)})")
-    n = len(ep)
-    cls = np.full(n, UNKNOWN, np.int64)
-    width = np.full(n, np.nan)
-    sectors = np.zeros(n, np.int64)
-    xy = pz[ep, st, :2]
-    for g in np.unique(sidx[ep]) if n else []:
-        m = sidx[ep] == g
-        r = classify_locations(glist[g], xy[m], params, labels[g], mask)
-        cls[m], width[m], sectors[m] = r["cls"], r["width"], r["sectors"]
+    glist, labels, sidx = _grid_lists(grids, pz.shape[0], scene_index, room_labels)
+    cls, width, sectors = _classify_at(glist, labels, sidx, pz, ep, st, params, mask)
     known = cls >= 0
     counts = np.bincount(cls[known], minlength=4)
     diff = np.asarray(events["difficulty"])[ep]
@@ -514,6 +525,31 @@ def type3_locations(grids, poses, events: dict, *, scene_index=None, room_labels
     return {"episode": ep, "step": st, "cls": cls, "width": width, "sectors": sectors, "classes": LOCATION_CLASSES,
             "counts": counts, "n_unknown": int((~known).sum()),
             "fractions": counts / counts.sum() if counts.sum() else np.full(4, np.nan), "counts_by_difficulty": by_d}
+
+
+def step_locations(grids, poses, steps_used, *, scene_index=None, room_labels=None,
+                   params: LocationParams = LocationParams(), mask="auto") -> dict:
+    """Location class of the pose before every planner step an episode used
+    (``poses[e, s]`` for ``s < steps_used[e]``): the base rate of where the
+    steps are spent, against which :func:`type3_locations` reads. Arguments
+    as :func:`type3_locations` (``steps_used``: (E,), e.g. ``events["steps_used"]``).
+
+    Returns:
+        dict with ``classes`` (names), ``counts`` (4,) steps per class,
+        ``n_unknown``, ``n`` (steps), ``fractions`` (4,) over classified steps.
+    """
+    pz = as_array(poses, "poses", ndim=3, dtype=np.float64)
+    used = as_array(steps_used, "steps_used", ndim=1).astype(np.int64)
+    if used.shape[0] != pz.shape[0] or (used.size and (used.min() < 0 or used.max() >= pz.shape[1])):
+        raise InputError(None, "steps_used", f"must give 0..{pz.shape[1] - 1} steps for each of {pz.shape[0]} episodes")
+    glist, labels, sidx = _grid_lists(grids, pz.shape[0], scene_index, room_labels)
+    ep = np.repeat(np.arange(pz.shape[0]), used)
+    st = np.concatenate([np.arange(u) for u in used]) if used.size else np.zeros(0, np.int64)
+    cls = _classify_at(glist, labels, sidx, pz, ep, st.astype(np.int64), params, mask)[0]
+    known = cls >= 0
+    counts = np.bincount(cls[known], minlength=4)
+    return {"classes": LOCATION_CLASSES, "counts": counts, "n_unknown": int((~known).sum()), "n": int(len(cls)),
+            "fractions": counts / counts.sum() if counts.sum() else np.full(4, np.nan)}
 
 
 # ---------------------------------------------------------------------------
@@ -706,114 +742,7 @@ def delta_u(poses, events: dict, *, h: int = 5, r: float = 1.0, cell: float = 0.
             "h": int(h), "r": float(r), "cell": float(cell)}
 
 
-# ---------------------------------------------------------------------------
-# Plots
-# ---------------------------------------------------------------------------
-
-
-def plot_question_timing(result: dict, path: str | os.PathLike, title: str | None = None):
-    """Share of each type's questions per progress bin. ``result``: :func:`question_timing`."""
-    e = result["edges"]
-    centers = 100 * (e[1:] + e[:-1]) / 2
-    fig, axs = new_figure(1, 1, size=(6.5, 4.2))
-    ax = axs[0, 0]
-    for t in range(4):
-        if result["n"][t]:
-            ax.plot(centers, 100 * result["share"][t], marker="o", ms=3, label=f"{TYPE_LABELS[t]} (n={result['n'][t]})")
-    ax.set_xlabel("episode progress when asked (step / steps used, %)")
-    ax.set_ylabel("share of the type's questions (%)")
-    ax.set_xlim(0, 100)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    ax.set_title(title or "When questions are asked", fontsize=10)
-    return save(fig, path)
-
-
-def plot_location_classes(result: dict, path: str | os.PathLike, title: str | None = None, content: dict | None = None):
-    """Share of Type-3 questions per location class (``result``:
-    :func:`type3_locations`) and, with ``content`` (:func:`type3_content`), a
-    second panel with the share per content class (or why it is not
-    applicable)."""
-    fig, axs = new_figure(1, 1 if content is None else 2, size=(5.5 if content is None else 11.0, 4.0))
-    if content is not None:
-        _plot_content(axs[0, 1], content)
-    ax = axs[0, 0]
-    x = np.arange(4)
-    frac = np.nan_to_num(result["fractions"])
-    ax.bar(x, 100 * frac, color=["#4c72b0", "#dd8452", "#c44e52", "#55a868"])
-    for i in x:
-        ax.text(i, 100 * frac[i] + 1, f"n={int(result['counts'][i])}", ha="center", fontsize=8)
-    ax.set_xticks(x)
-    ax.set_xticklabels([c.replace("_", " ") for c in LOCATION_CLASSES])
-    ax.set_xlabel("location class at the question pose")
-    ax.set_ylabel("share of Type-3 questions (%)")
-    ax.set_ylim(0, 105)
-    ax.set_title(title or f"Where Type-3 questions arise ({result['n_unknown']} unclassified)", fontsize=10)
-    return save(fig, path)
-
-
-def _plot_content(ax, content: dict) -> None:
-    if not content["applicable"]:
-        ax.text(0.5, 0.5, f"content split not applicable:\n{content['reason']}", ha="center", va="center",
-                fontsize=8, wrap=True, transform=ax.transAxes)
-        ax.set_axis_off()
-        return
-    x = np.arange(3)
-    frac = np.nan_to_num(content["fractions"])
-    ax.bar(x, 100 * frac, color=["#c44e52", "#4c72b0", "#8172b2"])
-    for i in x:
-        ax.text(i, 100 * frac[i] + 1, f"n={int(content['counts'][i])}", ha="center", fontsize=8)
-    ax.set_xticks(x)
-    ax.set_xticklabels(["route request", "goal-room position", "room relations"])
-    ax.set_xlabel("what the question asked (from its text)")
-    ax.set_ylabel("share of classified Type-3 questions (%)")
-    ax.set_ylim(0, 105)
-    ax.set_title(f"What Type-3 questions asked ({int(content['counts'][UNCLASSIFIED])} unclassified, "
-                 f"{content['n_without_text']} without text)", fontsize=10)
-
-
-def plot_questions_per_difficulty(result: dict, path: str | os.PathLike, title: str | None = None):
-    """Mean questions per episode by type and difficulty (one agent: the
-    result of :func:`questions_per_difficulty` without leading axes)."""
-    mean = np.asarray(result["mean_per_type"])
-    if mean.ndim != 2:
-        raise InputError(None, "result", "plot one agent's result (mean_per_type of shape (3, 4))")
-    fig, axs = new_figure(1, 1, size=(6.5, 4.2))
-    ax = axs[0, 0]
-    x = np.arange(3)
-    wbar = 0.16
-    for t in range(4):
-        ax.bar(x + (t - 2) * wbar, np.nan_to_num(mean[:, t]), wbar, label=TYPE_LABELS[t])
-    ax.bar(x + 2 * wbar, np.nan_to_num(result["mean_total"]), wbar, color="k", label="|Q| (all types)")
-    ax.set_xticks(x)
-    ax.set_xticklabels([f"{b} (n={int(c)})" for b, c in zip(BIN_NAMES, result["count"])])
-    ax.set_xlabel("episode difficulty")
-    ax.set_ylabel("questions per episode")
-    ax.legend(fontsize=8)
-    ax.set_title(title or "Interaction by difficulty", fontsize=10)
-    return save(fig, path)
-
-
-def plot_delta_u(result: dict, path: str | os.PathLike, title: str | None = None):
-    """Mean Delta-U per difficulty. ``result``: :func:`delta_u`."""
-    fig, axs = new_figure(1, 1, size=(5.5, 4.0))
-    ax = axs[0, 0]
-    x = np.arange(3)
-    m = np.nan_to_num(100 * result["mean"])
-    ax.bar(x, m, color=["#55a868", "#dd8452", "#c44e52"])
-    for i in x:
-        ax.text(i, m[i] + (1 if m[i] >= 0 else -4), f"n={int(result['count'][i])}", ha="center", fontsize=8)
-    ax.axhline(0, color="k", lw=0.8)
-    ax.set_xticks(x)
-    ax.set_xticklabels(list(BIN_NAMES))
-    ax.set_xlabel("episode difficulty")
-    ax.set_ylabel("Delta-U = (A_noQA - A_QA) / A_noQA (%)")
-    ax.set_title(title or f"Type-3 explored-area reduction (h={result['h']} steps, r={result['r']:g} m)", fontsize=10)
-    return save(fig, path)
-
-
 __all__ = ["CONTENT_CLASSES", "LOCATION_CLASSES", "UNKNOWN", "LocationParams", "layout_mask", "events_from_rows",
            "events_from_trajectory", "counts_from_events", "question_timing", "classify_locations", "type3_locations",
-           "classify_question", "type3_content",
-           "questions_per_difficulty", "explored_area", "delta_u", "plot_question_timing", "plot_location_classes",
-           "plot_questions_per_difficulty", "plot_delta_u"]
+           "step_locations", "classify_question", "type3_content",
+           "questions_per_difficulty", "explored_area", "delta_u"]

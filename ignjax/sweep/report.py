@@ -15,7 +15,6 @@ import math
 from pathlib import Path
 from types import SimpleNamespace
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from ignjax.agents.llm.catalog import LLM_AGENTS, get_llm_agent
@@ -25,12 +24,14 @@ from ignjax.evaluate.outcomes import (metric_rows, model_totals, outcome_rows, w
                                       write_trajectories)
 from ignjax.fileio import atomic_write
 from ignjax.protocol import BIN_INDEX, BIN_NAMES, FACTOR_NAMES
-from ignjax.scenes.viz.mapplot import plot_scene_map, save_figure
 from ignjax.studies import cost_derivation as C
 from ignjax.studies import cost_sensitivity as CS
 from ignjax.studies import difficulty_ablation as DA
 from ignjax.studies import interaction as IA
-from ignjax.studies._common import new_figure, save
+from ignjax.studies import interaction_plots as IP
+from ignjax.studies._common import save
+from ignjax.sweep.in_loop import InLoopRuns, in_loop_figure
+from ignjax.sweep.trajectories import plot_trajectories
 from ignjax.view.page import write_page
 from ignjax.view.runfolder import read_run
 
@@ -157,34 +158,14 @@ def study_costs(es, rollouts: dict, in_loop: dict | None, cfg: SweepConfig, out:
                          + [100 * float(succ[k].mean()), 100 * float((succ[k] * disc[k]).mean())])
         lheader = ["setting", "w1", "w2", "w3", "w4", "|Q|", "Q1", "Q2", "Q3", "Q4", f"SR@{thr:g}", f"WSR@{thr:g}"]
         write_csv(out / "costs_in_loop.csv", lheader, lrows)
-        _plot_in_loop(cfg, vecs, labels, nq, succ, disc, fig / "costs_in_loop.png")
+        silent = {a: float(arr["success"][i, :, cfg.eval.thresholds.index(thr)].mean())
+                  for i, a in enumerate(arr["names"]) if a == "explorer"}
+        runs = InLoopRuns(cfg.costs.agent, tuple(labels), tuple(cfg.costs.scales), float(cfg.costs.per_type_factor),
+                          nq, succ, disc, float(thr), silent)
+        save(in_loop_figure(runs), fig / "costs_in_loop.png")
         summary["in_loop_table"] = (lheader, lrows)
         summary["in_loop_agent"] = cfg.costs.agent
     return summary
-
-
-def _plot_in_loop(cfg: SweepConfig, vecs, labels, nq, succ, disc, path):
-    n_s = len(cfg.costs.scales)
-    scales = np.asarray(cfg.costs.scales)
-    fig, axs = new_figure(1, 2, size=(11.0, 4.0))
-    ax = axs[0, 0]
-    for t in range(4):
-        ax.plot(scales, nq[:n_s, :, t].mean(-1), marker="o", label=f"Type {t + 1}")
-    ax.plot(scales, nq[:n_s].sum(-1).mean(-1), marker="s", color="k", label="all types (|Q|)")
-    ax.set_xscale("log")
-    ax.set_xlabel("cost scale (x locked costs)")
-    ax.set_ylabel("questions per episode")
-    ax.set_title(f"{cfg.costs.agent}: asking vs charged costs")
-    ax.legend(fontsize=8)
-    ax = axs[0, 1]
-    ax.plot(scales, 100 * succ[:n_s].mean(-1), marker="o", label="SR@1.5")
-    ax.plot(scales, 100 * (succ[:n_s] * disc[:n_s]).mean(-1), marker="s", label="WSR@1.5 (charged costs)")
-    ax.set_xscale("log")
-    ax.set_xlabel("cost scale (x locked costs)")
-    ax.set_ylabel("rate (%)")
-    ax.set_title("success under the charged costs")
-    ax.legend(fontsize=8)
-    save(fig, path)
 
 
 def study_difficulty(es, rollouts: dict, cfg: SweepConfig, out: Path) -> dict:
@@ -251,6 +232,21 @@ def question_content(es, agent: str, tree: dict, events: dict) -> dict:
     return IA.type3_content(events, texts)
 
 
+def _threshold(cfg: SweepConfig) -> float:
+    """The success threshold the figures use: 1.5 m when evaluated, else the first."""
+    return 1.5 if 1.5 in cfg.eval.thresholds else float(cfg.eval.thresholds[0])
+
+
+def _drawn_agents(es, rollouts: dict, cfg: SweepConfig) -> tuple[dict, dict]:
+    """The rollouts the trajectory figures draw (every evaluated agent, then the analysed one) and each one's
+    (E,) success at :func:`_threshold`."""
+    names = [a for a in dict.fromkeys([*cfg.eval.agents, cfg.analysis.agent]) if a in rollouts]
+    drawn = {a: rollouts[a] for a in names}
+    arr = agent_arrays(es, drawn, cfg)
+    ti = cfg.eval.thresholds.index(_threshold(cfg))
+    return drawn, {a: arr["success"][i, :, ti] for i, a in enumerate(arr["names"])}
+
+
 def study_analysis(es, rollouts: dict, cfg: SweepConfig, out: Path) -> dict:
     agent = cfg.analysis.agent
     tree = rollouts[agent]
@@ -266,10 +262,12 @@ def study_analysis(es, rollouts: dict, cfg: SweepConfig, out: Path) -> dict:
     du = IA.delta_u(np.asarray(traj.pose), events, h=int(cfg.analysis.horizon), r=float(cfg.analysis.radius))
     content = question_content(es, agent, tree, events)
     fig = out / "figures"
-    IA.plot_question_timing(timing, fig / "analysis_timing.png")
-    IA.plot_location_classes(loc, fig / "analysis_type3_locations.png", content=content)
-    IA.plot_questions_per_difficulty(qpd, fig / "analysis_questions_per_difficulty.png")
-    IA.plot_delta_u(du, fig / "analysis_delta_u.png")
+    steps = IA.step_locations(grids, np.asarray(traj.pose), events["steps_used"], scene_index=scene_index,
+                              room_labels=labels)
+    IP.plot_question_timing(timing, fig / "analysis_timing.png")
+    IP.plot_location_classes(loc, fig / "analysis_type3_locations.png", content=content, steps=steps)
+    IP.plot_questions_per_difficulty(qpd, fig / "analysis_questions_per_difficulty.png")
+    IP.plot_delta_u(du, fig / "analysis_delta_u.png")
     kept = np.isfinite(du["delta_u"])
 
     def bin_mean(values, b):  # mean over the bin's counted questions (nan when none)
@@ -296,62 +294,11 @@ def study_analysis(es, rollouts: dict, cfg: SweepConfig, out: Path) -> dict:
         crows.append(["no text", content["n_without_text"], nan, content["n_without_text"] / n if n else nan])
         write_csv(out / "analysis_type3_content.csv", cheader, crows)
         ctable = (cheader, crows)
-    plots = plot_trajectories(es, tree, int(cfg.analysis.trajectories), fig, agent)
+    plots = plot_trajectories(es, *_drawn_agents(es, rollouts, cfg), int(cfg.analysis.trajectories), fig,
+                              int(cfg.run.seed), _threshold(cfg))
     return {"agent": agent, "per_difficulty": (header, rows), "locations": (lheader, lrows), "timing": timing,
             "delta_u": du,
             "content": content, "content_table": ctable, "trajectory_plots": plots}
-
-
-QUESTION_STYLE = {1: ("o", "tab:purple"), 2: ("s", "tab:orange"), 3: ("^", "tab:red"), 4: ("D", "tab:green")}
-
-
-def plot_trajectories(es, tree: dict, n: int, folder: Path, agent: str) -> list[Path]:
-    """Top-down plots of a few episodes (one per difficulty first, then in
-    file order): start, path, target, distractors and where each question
-    type was asked."""
-    if n <= 0:
-        return []
-    diff = [r["difficulty"] for r in es.records]
-    order = []
-    for b in BIN_NAMES:
-        order += [i for i, d in enumerate(diff) if d == b][:1]
-    order += [i for i in range(len(diff)) if i not in order]
-    paths = []
-    pose = np.asarray(tree["traj"]["pose"])
-    qs = np.asarray(tree["traj"]["question"])
-    kinds = np.asarray(tree["traj"]["kind"])
-    for i in order[:n]:
-        rec = es.records[i]
-        s = int(np.asarray(es.specs.scene)[i])
-        scene = es.bank.scene(s)
-        fig = plot_scene_map(scene, show_labels=False, title=f"{rec['episode_id']} ({rec['difficulty']}, {agent})")
-        ax = fig.axes[0]
-        used = int((kinds[i] >= 0).sum())
-        xy = pose[i, : used + 1, :2]
-        ax.plot(xy[:, 0], xy[:, 1], "-", color="k", lw=1.8, label="path")
-        ax.plot(xy[0, 0], xy[0, 1], "o", ms=9, mfc="white", mec="k", label="start")
-        ax.plot(xy[-1, 0], xy[-1, 1], "x", ms=9, color="k", label="end")
-        by_id = {inst.id: inst for inst in scene.instances}
-        tgt = by_id.get(rec["target_id"])
-        if tgt is not None:
-            same = [x for x in scene.instances if x.category == tgt.category and x.id != tgt.id]
-            if same:
-                ax.plot([x.position[0] for x in same], [x.position[1] for x in same], "*", ms=12,
-                        color="tab:gray", mec="k", label="distractors")
-            ax.plot(tgt.position[0], tgt.position[1], "*", ms=16, color="gold", mec="k", label="target")
-        for t, (m, c) in QUESTION_STYLE.items():
-            steps = np.nonzero(qs[i, :used] == t)[0]
-            if len(steps):
-                p = pose[i, steps, :2]  # pose before the ASK step
-                ax.plot(p[:, 0], p[:, 1], m, ms=8, color=c, mec="k", label=f"Type {t} asked")
-        ax.legend(fontsize=7, loc="upper right")
-        ax.set_xlabel("x (m)")
-        ax.set_ylabel("y (m)")
-        path = folder / f"trajectory_{len(paths)}.png"
-        save_figure(fig, path)
-        plt.close(fig)
-        paths.append(path)
-    return paths
 
 
 __all__ = ["VIEWER_FILE", "agent_arrays", "factors_of", "in_loop_costs", "plot_trajectories", "question_content",

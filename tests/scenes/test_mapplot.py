@@ -14,7 +14,8 @@ from matplotlib.colors import to_rgb
 from matplotlib.figure import Figure
 from matplotlib.image import imread
 
-from ignjax.scenes.viz.mapplot import ROOM_COLORS, category_color, plot_scene_map, save_figure
+from ignjax.scenes.viz.mapplot import (FAMILY_NAMES, ROOM_COLORS, category_color, category_family, plot_scene_map,
+                                      save_figure)
 from ignjax.scenes.procgen.generate import HouseParams, generate_house
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -55,8 +56,12 @@ def test_map_png_is_written_for_a_generated_house(house, tmp_path):
     assert ax.get_xlabel() == "x (m)" and ax.get_ylabel() == "y (m)"
     assert ax.get_aspect() == 1.0
     legend = [t.get_text() for t in ax.get_legend().get_texts()]
-    for category in house.categories():
-        assert category.replace("_", " ") in legend
+    for family in {category_family(c) for c in house.categories()}:  # one entry per family, with its count
+        assert any(t.startswith(FAMILY_NAMES[family] + " (") for t in legend), family
+    fig.canvas.draw()
+    box = ax.get_legend().get_window_extent(fig.canvas.get_renderer())
+    assert fig.bbox.x0 <= box.x0 and box.x1 <= fig.bbox.x1 + 0.5  # right of the map, not cut by the figure's edge
+    assert box.x0 >= ax.get_window_extent().x1
 
 
 def test_existing_file_is_replaced_atomically(house, tmp_path):

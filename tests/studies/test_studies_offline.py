@@ -18,6 +18,7 @@ from ignjax.errors import ConfigError, InputError
 from ignjax.studies import cost_sensitivity as CS
 from ignjax.studies import difficulty_ablation as DA
 from ignjax.studies import interaction as IA
+from ignjax.studies import interaction_plots as IP
 from ignjax.sim.types import OutcomeRow
 
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -491,9 +492,9 @@ def test_plots_write_pngs(tmp_path):
     loc = IA.type3_locations(_grid(CORRIDOR), traj.pose, ev)
     calls = [
         (CS.plot_marginal_wsr, res), (CS.plot_flip_map, res), (DA.plot_ordering, abl), (DA.plot_calibration, cal),
-        (IA.plot_question_timing, IA.question_timing(ev)), (IA.plot_location_classes, loc),
-        (IA.plot_questions_per_difficulty, IA.questions_per_difficulty(IA.counts_from_events(ev), ev["difficulty"])),
-        (IA.plot_delta_u, IA.delta_u(traj.pose, ev, h=3)),
+        (IP.plot_question_timing, IA.question_timing(ev)), (IP.plot_location_classes, loc),
+        (IP.plot_questions_per_difficulty, IA.questions_per_difficulty(IA.counts_from_events(ev), ev["difficulty"])),
+        (IP.plot_delta_u, IA.delta_u(traj.pose, ev, h=3)),
     ]
     for i, (fn, result) in enumerate(calls):
         path = tmp_path / "figs" / f"{fn.__name__}.png"

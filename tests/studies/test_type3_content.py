@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from ignjax.studies import interaction as IA
+from ignjax.studies import interaction_plots as IP
 
 QUESTIONS = {
     "route": ["Which way should I go to reach the kitchen?", "How do I get to the bedroom from here?",
@@ -65,5 +66,5 @@ def test_plot_with_the_content_panel(tmp_path):
     loc = {"fractions": np.array([0.5, 0.5, 0, 0]), "counts": np.array([1, 1, 0, 0]), "n_unknown": 0}
     for content in (IA.type3_content(ev, {(0, 0): "Which way?", (1, 1): "Where is the kitchen?"}),
                     IA.type3_content(ev, None, reason="no texts")):
-        path = IA.plot_location_classes(loc, tmp_path / f"loc_{content['applicable']}.png", content=content)
+        path = IP.plot_location_classes(loc, tmp_path / f"loc_{content['applicable']}.png", content=content)
         assert path.is_file() and path.stat().st_size > 0

@@ -5,7 +5,8 @@ renders one instance of every category of :data:`catalogue.CATALOGUE` with
 default attributes (medium size, colour and material left unset so that
 each builder shows its own default look; ``--sampled`` draws them as
 procedural houses do), plus one tile per state for categories that have
-states, and writes them as a grid with a caption under each tile.
+states, and writes them as a grid under a title line, with a caption under each
+tile (wrapped, never cut).
 
 Each tile is its own minimal scene: one square room with a floor, the
 object at the origin facing +x and, for objects that stand against or hang
@@ -30,11 +31,15 @@ import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 from tqdm import tqdm
 
-from ignjax.scenes.compile import compile_scene
-from ignjax.scenes.model import Attributes, Room, Scene, SceneMeta, Wall
-from ignjax.scenes.procgen import catalogue as cat
 from ignjax.scenes.viz import headless_gl
-from ignjax.scenes.viz.render import render_rgb
+
+if __name__ == "__main__":  # before anything imports mujoco, which reads MUJOCO_GL once
+    headless_gl()
+
+from ignjax.scenes.compile import compile_scene  # noqa: E402
+from ignjax.scenes.model import Attributes, Room, Scene, SceneMeta, Wall  # noqa: E402
+from ignjax.scenes.procgen import catalogue as cat  # noqa: E402
+from ignjax.scenes.viz.render import render_rgb  # noqa: E402
 
 FOVY = 40.0
 """Vertical field of view of the gallery camera, degrees."""
@@ -118,24 +123,57 @@ def _caption_font(size: int):
         return ImageFont.load_default()
 
 
-def compose(tiles: Sequence[tuple[str, np.ndarray]], size: int, cols: int | None = None):
-    """Arrange captioned tiles in a grid; returns a ``PIL.Image``."""
+def wrap_caption(draw, caption: str, font, width: int) -> list[str]:
+    """The caption's lines (its own line breaks kept), each broken at spaces
+    to fit ``width`` pixels; a single word wider than that is the only thing
+    cut (with an ellipsis)."""
+    lines: list[str] = []
+    for part in caption.split("\n"):
+        line = ""
+        for word in part.split(" "):
+            trial = f"{line} {word}" if line else word
+            if line and draw.textlength(trial, font=font) > width:
+                lines.append(line)
+                line = word
+            else:
+                line = trial
+        lines.append(line)
+    out = []
+    for line in lines:
+        while draw.textlength(line, font=font) > width and len(line) > 2:
+            line = line[:-2] + "…"
+        out.append(line)
+    return out
+
+
+def compose(tiles: Sequence[tuple[str, np.ndarray]], size: int, cols: int | None = None, title: str | None = None):
+    """Arrange captioned tiles in a grid, under an optional title line;
+    captions wrap onto as many lines as the longest needs (every row the
+    same height); returns a ``PIL.Image``."""
     n = len(tiles)
     cols = cols or max(1, min(n, int(math.ceil(math.sqrt(n * 1.6)))))
     rows = int(math.ceil(n / cols))
-    cap = max(14, size // 8)
     pad = 4
-    img = Image.new("RGB", (cols * (size + pad) + pad, rows * (size + cap + pad) + pad), (255, 255, 255))
-    draw = ImageDraw.Draw(img)
     font = _caption_font(size)
-    for k, (caption, tile) in enumerate(tiles):
+    probe = ImageDraw.Draw(Image.new("RGB", (1, 1)))
+    wrapped = [wrap_caption(probe, caption, font, size - 4) for caption, _ in tiles]
+    line_h = int(math.ceil(font.size * 1.25)) if hasattr(font, "size") else 12
+    cap = line_h * max([len(w) for w in wrapped] + [1]) + 2
+    width = cols * (size + pad) + pad
+    title_font = _caption_font(int(size * 1.8))
+    title_h = int(math.ceil(title_font.size * 1.3)) if hasattr(title_font, "size") else 16
+    title_lines = wrap_caption(probe, title, title_font, width - 2 * pad) if title else []
+    top = title_h * len(title_lines) + (pad if title_lines else 0)
+    img = Image.new("RGB", (width, top + rows * (size + cap + pad) + pad), (255, 255, 255))
+    draw = ImageDraw.Draw(img)
+    for j, line in enumerate(title_lines):
+        draw.text((pad + 2, pad + j * title_h), line, fill=(0, 0, 0), font=title_font)
+    for k, ((_, tile), lines) in enumerate(zip(tiles, wrapped)):
         r, c = divmod(k, cols)
-        x, y = pad + c * (size + pad), pad + r * (size + cap + pad)
+        x, y = pad + c * (size + pad), top + pad + r * (size + cap + pad)
         img.paste(Image.fromarray(np.asarray(tile, dtype=np.uint8)), (x, y))
-        text = caption
-        while draw.textlength(text, font=font) > size and len(text) > 4:
-            text = text[:-2] + "…" if not text.endswith("…") else text[:-3] + "…"
-        draw.text((x + 2, y + size + 1), text, fill=(20, 20, 20), font=font)
+        for j, line in enumerate(lines):
+            draw.text((x + 2, y + size + 1 + j * line_h), line, fill=(20, 20, 20), font=font)
     return img
 
 
@@ -158,11 +196,14 @@ def render_gallery(out, size: int = 160, names: Iterable[str] | None = None, col
         img = render_tile(name, attrs, size, seed)
         built = cat.CATALOGUE[name].build(attrs, np.random.default_rng(seed))
         dim = 200 * max(built.half_extents)
-        tiles.append((f"{caption} {dim:.0f}cm", img))
+        tiles.append((f"{caption}\n{dim:.0f} cm", img))
     out = os.fspath(out)
     os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
     tmp = f"{out}.tmp-{os.getpid()}"
-    compose(tiles, size, cols).save(tmp, format="PNG")
+    n_cats = len(dict.fromkeys(name for _, name, _ in items))
+    title = (f"Object catalogue: {n_cats} categories, {len(tiles)} tiles (one per state); "
+             "under each: category (state) and the largest side of its box")
+    compose(tiles, size, cols, title).save(tmp, format="PNG")
     os.replace(tmp, out)
     return tiles
 
@@ -188,5 +229,4 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    headless_gl()
     raise SystemExit(main())

@@ -1,7 +1,10 @@
 """Top-down maps of scenes (matplotlib, Agg; safe in notebooks and headless runs).
 
 :func:`plot_scene_map` draws rooms filled by label, walls, doors and object
-footprints coloured by category. It returns the figure and leaves the axes
+footprints coloured by family (:func:`category_family`: seating, tables,
+storage and beds, ... -- ten colours a reader can tell apart, where a colour
+per category would need a legend of fifty near-identical hues; the HTML
+viewer keeps :func:`category_color`). It returns the figure and leaves the axes
 usable, so callers can draw targets, distractors or trajectories on top::
 
     fig = plot_scene_map(scene, highlight={"laptop_0": "red"})
@@ -34,7 +37,8 @@ from matplotlib.patches import Arc, Patch, Polygon
 from ignjax.scenes import vocab
 from ignjax.scenes.model import Instance, Scene
 
-__all__ = ["ROOM_COLORS", "category_color", "plot_scene_map", "save_figure"]
+__all__ = ["FAMILY_COLORS", "FAMILY_NAMES", "ROOM_COLORS", "category_color", "category_family", "plot_scene_map",
+           "save_figure"]
 
 ROOM_COLORS: Mapping[str, str] = {
     "bedroom": "#cfe2f3",
@@ -52,8 +56,38 @@ ROOM_COLORS: Mapping[str, str] = {
 }
 """Fill colour of each room label."""
 
+FAMILY_NAMES: Mapping[str, str] = {
+    "seating": "seating",
+    "tables": "tables and desks",
+    "storage": "storage and beds",
+    "appliances": "appliances",
+    "electronics": "electronics",
+    "fixtures": "bath and heating",
+    "wall": "wall-hung",
+    "floor": "floor items",
+    "small": "small objects",
+    "other": "other",
+}
+"""Legend label of each family: the catalogue module a category's builder
+lives in (:mod:`ignjax.scenes.procgen.catalogue`), ``other`` for categories
+outside the catalogue (imported scenes)."""
+
+FAMILY_COLORS: Mapping[str, str] = {
+    "seating": "#4477aa",
+    "tables": "#ccbb44",
+    "storage": "#996633",
+    "appliances": "#66ccee",
+    "electronics": "#8866cc",
+    "fixtures": "#228833",
+    "wall": "#aa3377",
+    "floor": "#ee6677",
+    "small": "#ee9933",
+    "other": "#bbbbbb",
+}
+"""Fill colour of each family (Paul Tol's bright scheme and neighbours: distinct in print and for common colour
+vision deficiencies)."""
+
 _WALL_COLOR = "#2b2b2b"
-_LEGEND_ROWS = 30
 _PALETTE: tuple[tuple[float, float, float, float], ...] = tuple(
     tuple(float(v) for v in colormaps[name](k / 20 + 0.025)) for name in ("tab20", "tab20b", "tab20c") for k in range(20)
 )
@@ -66,6 +100,15 @@ def category_color(category: str) -> tuple[float, float, float, float]:
     """A stable colour for a category (the same in every process and run)."""
     h = zlib.crc32(category.encode("utf-8")) % len(_PALETTE)
     return _PALETTE[h]
+
+
+def category_family(category: str) -> str:
+    """The family (a key of :data:`FAMILY_NAMES`) of a category."""
+    from ignjax.scenes.procgen.catalogue import CATALOGUE  # on use: plain maps of imported scenes need no catalogue
+
+    spec = CATALOGUE.get(category)
+    family = spec.build.__module__.rpartition(".")[2] if spec is not None else "other"
+    return family if family in FAMILY_NAMES else "other"
 
 
 def _support_depth(scene: Scene) -> dict[str, int]:
@@ -128,6 +171,7 @@ def plot_scene_map(
     title: str | None = None,
     highlight: Mapping[str, object] | None = None,
     show_labels: bool = True,
+    legend: bool | None = None,
     dpi: int = 120,
 ) -> Figure:
     """Draw a top-down map of a scene.
@@ -141,19 +185,22 @@ def plot_scene_map(
         highlight: instance id -> matplotlib colour; those instances are
             drawn with a thick outline and a marker on top of everything.
             Unknown ids raise KeyError.
-        show_labels: write room labels and a legend of categories.
+        show_labels: write room labels (and, unless ``legend`` says
+            otherwise, the legend).
+        legend: draw the legend of families and doors right of the map
+            (default: ``show_labels``).
         dpi: resolution of the written PNG.
 
     Returns:
         The figure (``fig.axes[0]`` or the ``ax`` given holds the map).
     """
+    legend = show_labels if legend is None else legend
     own = ax is None
     if own:
         lo, hi = scene.bounds()
         w, h = max(float(hi[0] - lo[0]), 1.0), max(float(hi[1] - lo[1]), 1.0)
         scale = 9.0 / max(w, h)
-        n_legend = len({i.category for i in scene.objects}) + 3
-        extra = 1.7 * math.ceil(n_legend / _LEGEND_ROWS) + 0.4 if show_labels else 0.6
+        extra = 2.8 if legend else 0.6
         fig = Figure(figsize=(max(4.0, w * scale) + extra, max(3.5, h * scale) + 0.8))
         FigureCanvasAgg(fig)
         ax = fig.add_subplot(1, 1, 1)
@@ -177,7 +224,8 @@ def plot_scene_map(
         _draw_door(ax, door, t_default, centroids.get(door.rooms[0]))
 
     depth = _support_depth(scene)
-    seen_cats: list[str] = []
+    families: dict[str, int] = {}  # family -> instances drawn
+    hatched = False
     for inst in sorted(scene.instances, key=lambda i: (i.structural is False, depth.get(i.id, 0), i.bbox.zmax, i.id)):
         if inst.structural and inst.category in ("floor", "ceiling", "room"):
             continue
@@ -185,13 +233,15 @@ def plot_scene_map(
             ax.add_patch(Polygon(inst.bbox.footprint(), closed=True, facecolor=_WALL_COLOR, edgecolor=_WALL_COLOR,
                                  lw=0.3, zorder=2))
             continue
-        col = category_color(inst.category)
+        family = category_family(inst.category)
+        col = FAMILY_COLORS[family]
         wall_mounted = inst.support is None and inst.position[2] > 0.3
         z = 4 + (1 if wall_mounted else 0) + 2 * depth.get(inst.id, 0)
         ax.add_patch(Polygon(inst.bbox.footprint(), closed=True, facecolor=col, edgecolor="black",
                              lw=0.4, alpha=0.9, zorder=z, hatch="///" if wall_mounted else None))
-        if not inst.structural and inst.category not in seen_cats:
-            seen_cats.append(inst.category)
+        if not inst.structural:
+            families[family] = families.get(family, 0) + 1
+            hatched |= wall_mounted
 
     if highlight:
         by_id = {i.id: i for i in scene.instances}
@@ -208,14 +258,17 @@ def plot_scene_map(
             ax.text(cx, cy, vocab.ROOM_DISPLAY.get(r.label, r.label), ha="center", va="center", fontsize=8,
                     color="#333333", zorder=11,
                     bbox={"boxstyle": "round,pad=0.15", "facecolor": "white", "alpha": 0.6, "edgecolor": "none"})
-        handles = [Patch(facecolor=category_color(c), edgecolor="black", lw=0.4, label=vocab.category_display(c))
-                   for c in sorted(seen_cats)]
+    if legend:
+        handles = [Patch(facecolor=FAMILY_COLORS[f], edgecolor="black", lw=0.4, label=f"{FAMILY_NAMES[f]} ({families[f]})")
+                   for f in FAMILY_NAMES if f in families]
+        if hatched:
+            handles.append(Patch(facecolor="white", edgecolor="black", lw=0.4, hatch="///",
+                                 label="hatched: wall-mounted"))
         handles += [Line2D([], [], color=_DOOR_COLOR, lw=1.5, label="door"),
                     Line2D([], [], color=_OPENING_COLOR, lw=1.5, ls="--", label="opening"),
                     Line2D([], [], color=_EXTERIOR_DOOR_COLOR, lw=1.5, label="exterior door")]
-        ncol = math.ceil(len(handles) / _LEGEND_ROWS)
-        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=6.5, ncol=ncol,
-                  frameon=False, borderaxespad=0.0)
+        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, frameon=False,
+                  borderaxespad=0.0, title="objects (instances)", title_fontsize=8, alignment="left")
 
     ax.set_aspect("equal")
     ax.autoscale_view()
