@@ -12,8 +12,8 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 from ignjax.scenes.viz.mapplot import FAMILY_NAMES, category_family, plot_scene_map, save_figure
 from ignjax.studies import cost_sensitivity as CS
-from ignjax.studies import interaction as IA
 from ignjax.studies import interaction_plots as IP
+from ignjax.studies import locations as LOC
 from ignjax.sweep.in_loop import InLoopRuns, in_loop_figure
 from ignjax.sweep.trajectories import MARK_Z, AgentPath, pick_episodes, trajectory_figure
 
@@ -222,7 +222,7 @@ def test_step_locations_count_every_step_used():
     grid.navigable[50:150, 50:150] = True  # a 5 m square room
     grid.origin, grid.resolution, grid.room = np.zeros(2), 0.05, np.where(grid.navigable, 0, -1)
     poses = np.full((2, 6, 3), 5.0)
-    r = IA.step_locations(grid, poses, np.array([5, 2]))
+    r = LOC.step_locations(grid, poses, np.array([5, 2]))
     assert r["n"] == 7 and r["counts"].tolist() == [0, 0, 0, 7] and r["fractions"][3] == 1.0
 
 

@@ -15,7 +15,8 @@ import numpy as np
 from ignjax.errors import InputError
 from ignjax.protocol import BIN_NAMES, TYPE_LABELS
 from ignjax.studies._common import new_figure, save
-from ignjax.studies.interaction import LOCATION_CLASSES, UNCLASSIFIED
+from ignjax.studies.interaction import UNCLASSIFIED
+from ignjax.studies.locations import LOCATION_CLASSES
 
 TYPE_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red")
 """Colour of each question type (the same in every figure of the report)."""
@@ -55,8 +56,8 @@ def plot_question_timing(result: dict, path: str | os.PathLike, title: str | Non
 def location_classes_figure(result: dict, title: str | None = None, content: dict | None = None,
                             steps: dict | None = None):
     """Share of Type-3 questions per location class (``result``:
-    :func:`~ignjax.studies.interaction.type3_locations`) next to the share of
-    all planner steps spent there (``steps``: :func:`~ignjax.studies.interaction.step_locations`,
+    :func:`~ignjax.studies.locations.type3_locations`) next to the share of
+    all planner steps spent there (``steps``: :func:`~ignjax.studies.locations.step_locations`,
     the base rate), and, with an applicable ``content``
     (:func:`~ignjax.studies.interaction.type3_content`), a second panel with
     the share per content class. A content split that does not apply draws

@@ -29,6 +29,7 @@ from ignjax.studies import cost_sensitivity as CS
 from ignjax.studies import difficulty_ablation as DA
 from ignjax.studies import interaction as IA
 from ignjax.studies import interaction_plots as IP
+from ignjax.studies import locations as LOC
 from ignjax.studies._common import save
 from ignjax.sweep.in_loop import InLoopRuns, in_loop_figure
 from ignjax.sweep.trajectories import plot_trajectories
@@ -257,12 +258,12 @@ def study_analysis(es, rollouts: dict, cfg: SweepConfig, out: Path) -> dict:
     grids = list(es.bank.navgrids)
     labels = [[room.label for room in es.bank.scene(i).rooms] for i in range(len(grids))]
     scene_index = np.asarray(es.specs.scene)
-    loc = IA.type3_locations(grids, np.asarray(traj.pose), events, scene_index=scene_index, room_labels=labels)
+    loc = LOC.type3_locations(grids, np.asarray(traj.pose), events, scene_index=scene_index, room_labels=labels)
     qpd = IA.questions_per_difficulty(np.asarray(tree["out"]["n_questions"]), diff)
     du = IA.delta_u(np.asarray(traj.pose), events, h=int(cfg.analysis.horizon), r=float(cfg.analysis.radius))
     content = question_content(es, agent, tree, events)
     fig = out / "figures"
-    steps = IA.step_locations(grids, np.asarray(traj.pose), events["steps_used"], scene_index=scene_index,
+    steps = LOC.step_locations(grids, np.asarray(traj.pose), events["steps_used"], scene_index=scene_index,
                               room_labels=labels)
     IP.plot_question_timing(timing, fig / "analysis_timing.png")
     IP.plot_location_classes(loc, fig / "analysis_type3_locations.png", content=content, steps=steps)

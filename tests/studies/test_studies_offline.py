@@ -19,6 +19,7 @@ from ignjax.studies import cost_sensitivity as CS
 from ignjax.studies import difficulty_ablation as DA
 from ignjax.studies import interaction as IA
 from ignjax.studies import interaction_plots as IP
+from ignjax.studies import locations as LOC
 from ignjax.sim.types import OutcomeRow
 
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -327,29 +328,29 @@ ROOM = (2.5, 7.5, 2.5, 7.5)
     ((CORRIDOR, ROOM), (5.0, 5.0), "room"),
 ])
 def test_location_classes_on_hand_built_masks(rects, xy, want):
-    r = IA.classify_locations(_grid(*rects), np.array([xy]))
-    assert IA.LOCATION_CLASSES[r["cls"][0]] == want
+    r = LOC.classify_locations(_grid(*rects), np.array([xy]))
+    assert LOC.LOCATION_CLASSES[r["cls"][0]] == want
 
 
 def test_location_rule_details():
     corridor = _grid(CORRIDOR)
-    r = IA.classify_locations(corridor, np.array([[5.0, 5.0], [5.0, 5.45], [5.0, 7.0], [1.3, 5.0]]))
-    assert IA.LOCATION_CLASSES[r["cls"][0]] == "corridor"
+    r = LOC.classify_locations(corridor, np.array([[5.0, 5.0], [5.0, 5.45], [5.0, 7.0], [1.3, 5.0]]))
+    assert LOC.LOCATION_CLASSES[r["cls"][0]] == "corridor"
     assert r["width"][0] == pytest.approx(0.8, abs=0.05)  # the corridor's width on the mask
     assert r["sectors"][0] == 2 and r["sectors"][3] == 1
     assert r["lengths"][0, 0] == pytest.approx(2.0) and r["lengths"][0, 4] == pytest.approx(0.4, abs=0.05)
     # 5 cm off the mask: snapped back; 1.6 m away: unknown
-    assert r["snapped"][1] and IA.LOCATION_CLASSES[r["cls"][1]] == "corridor"
-    assert r["cls"][2] == IA.UNKNOWN
+    assert r["snapped"][1] and LOC.LOCATION_CLASSES[r["cls"][1]] == "corridor"
+    assert r["cls"][2] == LOC.UNKNOWN
     # room labels: a narrow passage inside a bedroom is inside a room; a wide hallway is a corridor
-    assert IA.classify_locations(corridor, np.array([[5.0, 5.0]]), room_labels=["bedroom"])["cls"][0] == IA.ROOM
-    assert IA.classify_locations(corridor, np.array([[5.0, 5.0]]), room_labels=["hallway"])["cls"][0] == IA.CORRIDOR
+    assert LOC.classify_locations(corridor, np.array([[5.0, 5.0]]), room_labels=["bedroom"])["cls"][0] == LOC.ROOM
+    assert LOC.classify_locations(corridor, np.array([[5.0, 5.0]]), room_labels=["hallway"])["cls"][0] == LOC.CORRIDOR
     hall = _grid(ROOM)
-    assert IA.classify_locations(hall, np.array([[5.0, 5.0]]), room_labels=["hallway"])["cls"][0] == IA.CORRIDOR
+    assert LOC.classify_locations(hall, np.array([[5.0, 5.0]]), room_labels=["hallway"])["cls"][0] == LOC.CORRIDOR
     with pytest.raises(ConfigError, match="n_rays"):
-        IA.LocationParams(n_rays=3)
+        LOC.LocationParams(n_rays=3)
     with pytest.raises(ConfigError, match="mask"):
-        IA.classify_locations(corridor, np.array([[5.0, 5.0]]), mask="walls")
+        LOC.classify_locations(corridor, np.array([[5.0, 5.0]]), mask="walls")
 
 
 def test_layout_mask_ignores_low_furniture():
@@ -365,7 +366,7 @@ def test_layout_mask_ignores_low_furniture():
     r = 0.18
     grid = SimpleNamespace(room=room, bands=bands, config=SimpleNamespace(agent_radius=r), origin=np.zeros(2),
                            resolution=RES)
-    lay = IA.layout_mask(grid)
+    lay = LOC.layout_mask(grid)
     blocked = (room < 0) | bands.any(0)
     from scipy import ndimage
     nav = ~ndimage.binary_dilation(blocked, structure=np.ones((9, 9), bool), border_value=1) & (room >= 0)
@@ -374,9 +375,9 @@ def test_layout_mask_ignores_low_furniture():
     assert not lay[100, 128]  # in the wardrobe
     assert not lay[100, 50] and lay[100, 54] and not lay[100, 53]  # 0.18 m agent from the west wall
     assert lay[nav].all()
-    auto = IA.classify_locations(grid, np.array([[3.0, 5.0]]))  # the strip between wall and bed
-    narrow = IA.classify_locations(grid, np.array([[3.0, 5.0]]), mask="navigable")
-    assert auto["cls"][0] == IA.ROOM and narrow["width"][0] < 0.5
+    auto = LOC.classify_locations(grid, np.array([[3.0, 5.0]]))  # the strip between wall and bed
+    narrow = LOC.classify_locations(grid, np.array([[3.0, 5.0]]), mask="navigable")
+    assert auto["cls"][0] == LOC.ROOM and narrow["width"][0] < 0.5
 
 
 def _episodes():
@@ -471,13 +472,13 @@ def test_type3_locations_over_several_grids():
     pose[0, 3, :2] = (5.0, 5.0)  # episode 0 asks at a T-junction
     pose[1, 4, :2] = (5.0, 5.0)  # episode 1 inside an open room
     grids = [_grid(CORRIDOR, STEM), _grid(ROOM)]
-    r = IA.type3_locations(grids, pose, ev, scene_index=[0, 1])
-    np.testing.assert_array_equal(r["cls"], [IA.JUNCTION, IA.ROOM])
+    r = LOC.type3_locations(grids, pose, ev, scene_index=[0, 1])
+    np.testing.assert_array_equal(r["cls"], [LOC.JUNCTION, LOC.ROOM])
     np.testing.assert_array_equal(r["counts"], [0, 1, 0, 1])
     np.testing.assert_allclose(r["fractions"], [0, 0.5, 0, 0.5])
-    assert r["counts_by_difficulty"][2, IA.JUNCTION] == 1 and r["counts_by_difficulty"][0, IA.ROOM] == 1
+    assert r["counts_by_difficulty"][2, LOC.JUNCTION] == 1 and r["counts_by_difficulty"][0, LOC.ROOM] == 1
     with pytest.raises(InputError, match="scene_index"):
-        IA.type3_locations(grids, pose, ev)
+        LOC.type3_locations(grids, pose, ev)
 
 
 def test_plots_write_pngs(tmp_path):
@@ -489,7 +490,7 @@ def test_plots_write_pngs(tmp_path):
     cal = DA.calibrate(factors, 1 - succ, None, DA.alpha_grid(0.25))
     traj, rows = _episodes()
     ev = IA.events_from_rows(rows)
-    loc = IA.type3_locations(_grid(CORRIDOR), traj.pose, ev)
+    loc = LOC.type3_locations(_grid(CORRIDOR), traj.pose, ev)
     calls = [
         (CS.plot_marginal_wsr, res), (CS.plot_flip_map, res), (DA.plot_ordering, abl), (DA.plot_calibration, cal),
         (IP.plot_question_timing, IA.question_timing(ev)), (IP.plot_location_classes, loc),
