@@ -397,10 +397,13 @@ def _section_costs(results: dict, es, rollouts: dict, cfg, out: Path) -> list[st
         parts += _zero_asking(cs, results, rollouts, cfg)
         parts += figure("figures/costs_in_loop.png", f"{agent}: questions and success against the cost scale",
                         f"Left: `{agent}`'s questions per episode against the cost scale (ticks at the scales run, "
-                        f"x{min(cfg.costs.scales):g} to x{max(cfg.costs.scales):g}), per type and in total, with the "
-                        "runs that raise one type's cost as separate markers. Right: its SR@1.5 and WSR@1.5, with "
-                        "`explorer` (never asks) as a reference line. Look for asking falling to zero as costs rise "
-                        "and success falling toward the reference.")
+                        f"x{min(cfg.costs.scales):g} to x{max(cfg.costs.scales):g}), per type and in total; right: its "
+                        "SR@1.5 and WSR@1.5, with `explorer` (never asks) as a reference line."
+                        + (f" Bottom row: the runs that raise one type's cost x{cfg.costs.per_type_factor:g}, that "
+                           "type's questions against the locked costs' and the success they leave."
+                           if cfg.costs.per_type_factor > 0 else "")
+                        + " Bars and bands are 95% intervals over the episodes. Look for asking falling to zero as "
+                        "costs rise and success falling toward the reference.")
     return parts
 
 
@@ -489,8 +492,10 @@ def _section_analysis(results: dict, es, rollouts: dict, cfg, out: Path) -> list
                     "Share of each type's questions by how far into the episode they were asked. Look for the "
                     "order: appearance and region early, confirmation late.")
     parts += figure("figures/analysis_type3_locations.png", "Where route questions were asked",
-                    "Share of route (Type-3) questions per location class (and per content class when the agent "
-                    "writes question text). Look for junctions and corridors, where a route hint helps most.")
+                    "Share of route (Type-3) questions per location class, next to the share of all planner steps "
+                    "spent in each class (the base rate), and per content class when the agent writes question "
+                    "text. Look for classes where questions are more frequent than steps: junctions and "
+                    "corridors, where a route hint helps most.")
     parts += figure("figures/analysis_questions_per_difficulty.png", "Questions per episode by type and difficulty",
                     "Questions per episode of each type on easy, medium and hard episodes. Look for which types "
                     "grow with difficulty.")
@@ -498,11 +503,14 @@ def _section_analysis(results: dict, es, rollouts: dict, cfg, out: Path) -> list
                     "Mean Delta-U (%) per difficulty; bars below zero mean the agent covered more floor after the "
                     "answer than before it. Compare the sign with the paper's positive values.")
     plots = an["trajectory_plots"]
-    for k, p in enumerate(plots):
-        parts += figure(p.relative_to(out).as_posix(), f"Trajectories on example episode {k + 1} of {len(plots)}",
-                        "Several agents on the same episode, each path coloured by time (start to end), the "
-                        "target and its distractors marked, each agent's outcome in the title. Look at where the "
-                        "paths part and where the questions were asked.")
+    for k, (p, rec) in enumerate(plots):
+        what = f"the {rec['difficulty']} episode `{rec['episode_id']}` (find a {rec['target_category'].replace('_', ' ')})"
+        parts += figure(p.relative_to(out).as_posix(), f"Trajectories of every agent on {rec['episode_id']}",
+                        f"Figure {k + 1} of {len(plots)}: every agent on {what}, one panel each, the path coloured "
+                        "by planner step with arrows for the direction of travel, the target (gold star) and its "
+                        "same-category distractors (grey stars) on top of the furniture, where each question type "
+                        "was asked, and each agent's outcome in its panel's title. Look at where the paths part and "
+                        "what the questions changed.")
     return parts
 
 

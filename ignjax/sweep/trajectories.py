@@ -195,10 +195,10 @@ def agent_paths(tree: dict, index: int, agent: str, success: bool, threshold: fl
 
 
 def plot_trajectories(es, rollouts: dict, success: dict, n: int, folder: Path, seed: int,
-                      threshold: float) -> list[Path]:
+                      threshold: float) -> list[tuple[Path, dict]]:
     """``trajectory_<k>.png`` for :func:`pick_episodes`' ``n`` episodes of
     ``es``, one panel per agent of ``rollouts`` (``success``: agent -> (E,)
-    bool at ``threshold``)."""
+    bool at ``threshold``); returns each figure's path with its episode record."""
     if n <= 0 or not rollouts:
         return []
     scene_of = np.asarray(es.specs.scene)
@@ -207,7 +207,7 @@ def plot_trajectories(es, rollouts: dict, success: dict, n: int, folder: Path, s
     for k, i in enumerate(picked):
         runs = [agent_paths(tree, i, name, success[name][i], threshold) for name, tree in rollouts.items()]
         fig = trajectory_figure(es.bank.scene(int(scene_of[i])), es.records[i], runs)
-        paths.append(save_figure(fig, folder / f"trajectory_{k}.png", dpi=110))
+        paths.append((save_figure(fig, folder / f"trajectory_{k}.png", dpi=110), es.records[i]))
     return paths
 
 
