@@ -18,6 +18,7 @@ from ignjax.rl import actions as A
 from ignjax.rl import make_params, obs_layout, obs_size
 from ignjax.rl.params import draw_costs
 from ignjax.sim import types as T
+from ignjax.sim.env import check_action
 from ignjax.sim.world import World
 
 B = 4
@@ -66,7 +67,6 @@ def test_the_action_table_follows_the_protocol(rl):
     assert list(table["direction"][:16]) == list(range(8)) * 2
     E = jax.tree.map(np.asarray, a)
     for k in range(A.n_actions(cfg)):  # every table action is in range (no clamping, no invalid count)
-        from ignjax.sim.env import check_action
         check_action(jax.tree.map(lambda x: x[k], E))
 
 
