@@ -37,6 +37,12 @@ process, on the same inputs:
   controller's probes, the oracle, the rest of the step and the
   observation, each run as a program of its own on one device's share of
   the B = 4096 rollouts, beside that share's fused rollout (``whole``).
+* **rl** - the RL environment (:mod:`ignjax.rl`, :mod:`ignjax.bench.rl`):
+  environment steps/s at B = 4096 with random valid actions and auto-reset
+  (``env_steps_per_s``; one jitted scan of 20 steps sharded over the devices),
+  next to the ``random`` agent's rollout decision steps/s on the same
+  episodes, timed in turns in the same run (``random_rollout_steps_per_s``),
+  and their ``ratio``.
 * **compile_s** - first call of the EIG agent's rollout at B = 256.
 * **time_to_result** - what a researcher waits for a result
   (:mod:`ignjax.bench.time_to_result`): ``evaluate --agent eig`` on the
@@ -52,6 +58,7 @@ process, on the same inputs:
 ``--json``: the last line of stdout is one JSON object with every figure.
 ``--llm``: only the MLLM host loop's figures (:mod:`ignjax.bench.llm`).
 ``--pieces``: only the ``pieces`` block.
+``--rl``: only the ``rl`` block.
 ``--time-to-result``: only the ``time_to_result`` block.
 ``--scaling``: only how cost grows (:mod:`ignjax.bench.scaling`): steps/s and
 memory against batch size, scenes in the bank, devices and cost vectors, as
@@ -88,6 +95,9 @@ def main(argv=None) -> int:
     p.add_argument("--pieces", action="store_true",
                    help="only where a decision step's time goes: microseconds per decision of each piece of the step "
                         "(ignjax.bench.pieces); with --quick the EIG and random agents")
+    p.add_argument("--rl", action="store_true",
+                   help="only the rl block: the RL environment's steps/s at B = 4096 with random valid actions and "
+                        "auto-reset, next to the random agent's rollout (ignjax.bench.rl)")
     p.add_argument("--time-to-result", action="store_true",
                    help="only the time_to_result block: evaluate, a quick sweep and the in-the-loop sweep, each cold "
                         "and warm in fresh processes (ignjax.bench.time_to_result)")
@@ -139,6 +149,11 @@ def main(argv=None) -> int:
         res["time_to_result"] = _time_to_result(episodes)
         print(json.dumps(res, sort_keys=True) if args.json else json.dumps(res, indent=2, sort_keys=True))
         return 0
+    if args.rl:
+        es = load_benchmark(episodes)
+        res["rl"] = _rl(es, make_world(es))
+        print(json.dumps(res, sort_keys=True) if args.json else json.dumps(res, indent=2, sort_keys=True))
+        return 0
     if args.pieces:
         es = load_benchmark(episodes)
         res["pieces"] = _pieces(es, make_world(es), ("random", "eig") if args.quick else AGENTS)
@@ -166,6 +181,7 @@ def main(argv=None) -> int:
     log(f"  each batch sharded over {batch_parts()} {jax.default_backend()} devices")
     res["steps_per_s"], res["compile_s"] = bench_steps(es, world, agents, sizes)
     log(f"  EIG rollout compile {res['compile_s']:.1f} s")
+    res["rl"] = _rl(es, world)
     log(f"what the machine allows a decision step (B = {LIMIT_BATCH}) ...")
     res["limit"] = bench_limit(es, world, agents, LIMIT_BATCH, res["steps_per_s"], args.quick)
     res["pieces"] = _pieces(es, world, agents)
@@ -185,6 +201,14 @@ def _time_to_result(episodes) -> dict:
 
     log("time to result (fresh processes; cold = empty cache folder, then warm) ...")
     return bench_time_to_result(str(episodes), log=log)
+
+
+def _rl(es, world) -> dict:
+    """:func:`ignjax.bench.rl.bench_rl` at B = 4096, with its progress lines."""
+    from ignjax.bench.rl import RL_BATCH, bench_rl
+
+    log(f"RL environment (B = {RL_BATCH}, random valid actions, auto-reset) ...")
+    return bench_rl(es, world)
 
 
 def _pieces(es, world, agents) -> dict:

@@ -1,5 +1,5 @@
-"""The optional parts of the install (extras): ``pip install "ignjax[llm]"``
-and ``"ignjax[render]"``. A module that needs one imports its packages with
+"""The optional parts of the install (extras): ``pip install "ignjax[llm]"``,
+``"ignjax[render]"`` and ``"ignjax[rl]"``. A module that needs one imports its packages with
 :func:`optional_module`, so that the core install still imports it, and a
 command checks with :func:`require_extra` before any work; either way a user
 without the part reads one line naming the ``pip install`` that adds it."""
@@ -10,7 +10,8 @@ import importlib
 
 from ignjax.errors import IgnjaxError
 
-EXTRAS = {"llm": "MLLM agents and the scripted model server", "render": "MuJoCo Warp's batch renderer"}
+EXTRAS = {"llm": "MLLM agents and the scripted model server", "render": "MuJoCo Warp's batch renderer",
+          "rl": "the Gymnasium vector-environment adapter of the RL environment"}
 """The optional parts of the install (``pip install "ignjax[NAME]"``) and what each one is for."""
 
 

@@ -214,7 +214,7 @@ def shard_layout(n: int, parts: int, copies: int = 1, chunk: int | None = None) 
 _REPLICAS: dict = {}
 
 
-def _replicated(world: World, mesh: Mesh) -> World:
+def replicate_world(world: World, mesh: Mesh) -> World:
     """``world`` with a copy on every device of ``mesh``, made once per world
     and mesh and dropped with the world: the scene bank is large (about half
     a gigabyte for the shipped benchmark), and copying it to the devices on
@@ -239,7 +239,7 @@ def _sharded_args(fn, world, specs, agent, params, keys, chunk, parts: int, copi
     size = rows * parts
     specs, keys = pad_batch(specs, keys, size)
     mesh = device_mesh(parts)
-    return ((_replicated(world, mesh), specs, params, keys),
+    return ((replicate_world(world, mesh), specs, params, keys),
             dict(fn=fn, agent=agent, widths=widths, mesh=mesh, out_axis=out_axis), size)
 
 

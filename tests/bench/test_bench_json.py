@@ -25,6 +25,7 @@ import pytest
 from ignjax.agents import get_agent
 from ignjax.bench.pieces import PIECES, bench_pieces
 from ignjax.bench.rays import bench_probe_rays
+from ignjax.bench.rl import bench_rl
 from ignjax.bench.rollouts import bench_steps
 
 RAY_KEYS = {"fast", "mjx", "mj_multiray", "rollout_depth_march"}
@@ -33,7 +34,9 @@ STUDY_KEYS = {"offline_wsr_1e6_x_500_s", "in_loop_vectors", "in_loop_episodes", 
               "in_loop_episodes_per_s"}
 TOP_KEYS = {"device", "quick", "n_rays", "ngeom", "rays_per_s", "ray_agreement", "ray_agreement_depth_march",
             "scene_compile_s", "speedup_vs_mjx", "speedup_vs_multiray", "probe_ray_agreement", "rollout_parts",
-            "steps_per_s", "compile_s", "studies", "limit", "pieces", "scaling", "time_to_result"}
+            "steps_per_s", "compile_s", "studies", "limit", "pieces", "scaling", "time_to_result", "rl"}
+RL_KEYS = {"batch", "steps_per_call", "parts", "env_steps_per_s", "episodes_per_s", "random_rollout_steps_per_s", "ratio",
+           "compile_s"}
 SIZES = ("256", "1024", "4096")
 
 
@@ -82,6 +85,7 @@ def check_record(res: dict) -> None:
     assert all(_positive(v) for v in lim["rates"].values()), lim["rates"]
     check_pieces(res["pieces"], ("random", "eig"), decisions_within=PIECES_DECISIONS_WITHIN)
     check_time_to_result(res["time_to_result"])
+    check_rl(res["rl"], 4096)
     s = res["studies"]
     assert set(s) == STUDY_KEYS
     assert s["in_loop_vectors"] == 16 and s["in_loop_episodes"] == 500  # --quick: K = 16
@@ -128,6 +132,19 @@ def test_pieces_follow_the_rollout(small_benchmark, small_world):
     block = bench_pieces(small_benchmark["set"], small_world, ("shortest_path",), 16, repeats=1)
     assert block["rows"] == 8 and block["batch"] == 16  # one device's share of 16 over the session's 2 devices
     check_pieces(block, ("shortest_path",))
+
+
+def check_rl(rec: dict, batch: int) -> None:
+    assert set(rec) == RL_KEYS and rec["batch"] == batch and rec["steps_per_call"] == 20 and rec["parts"] >= 1
+    assert all(_positive(rec[k]) for k in ("env_steps_per_s", "episodes_per_s", "random_rollout_steps_per_s", "ratio"))
+    assert math.isclose(rec["ratio"], rec["env_steps_per_s"] / rec["random_rollout_steps_per_s"])
+
+
+def test_rl_figures(small_benchmark, small_world):
+    """The ``rl`` block at a small batch: env steps/s next to the random rollout's, plain JSON values."""
+    rec = bench_rl(small_benchmark["set"], small_world, batch=8, repeats=1)
+    check_rl(rec, 8)
+    assert json.loads(json.dumps(rec)) == rec
 
 
 def test_probe_ray_agreement_figures():

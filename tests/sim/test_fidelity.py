@@ -42,6 +42,16 @@ def test_every_field_an_agent_receives_has_an_allow_list_entry():
     assert all(len(reason) > 15 for reason in T.AGENT_FIELDS.values())
 
 
+def test_the_rl_observation_vector_reads_allow_listed_fields_only():
+    """The RL environment's observation vector (:mod:`ignjax.rl.obs`) names
+    the fields each slice is computed from: allow-listed ones, or the
+    episode's costs (tests/rl/test_obs.py checks that nothing else enters it)."""
+    from ignjax.rl.obs import COSTS_SOURCE, obs_layout
+
+    sources = {src for s in obs_layout() for src in s.sources}
+    assert sources - set(T.AGENT_FIELDS) == {COSTS_SOURCE}
+
+
 def test_answers_carry_codes_only_and_no_world_point(small_benchmark, small_world):
     """Every answer leaf is an integer or boolean code after each question
     type (no float can carry a coordinate, distance or heading), and the

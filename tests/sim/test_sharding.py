@@ -164,9 +164,9 @@ def test_world_is_copied_to_the_devices_once_per_world(small_benchmark):
     es = small_benchmark["set"]
     world = World(es.bank, es.fields, SimConfig())
     mesh = R.device_mesh(2)
-    copy = R._replicated(world, mesh)
-    assert R._replicated(world, mesh) is copy
-    assert R._replicated(world, R.device_mesh(1)) is world  # one device: the world as it is
+    copy = R.replicate_world(world, mesh)
+    assert R.replicate_world(world, mesh) is copy
+    assert R.replicate_world(world, R.device_mesh(1)) is world  # one device: the world as it is
     leaf = jax.tree.leaves(copy)[0]
     assert len(leaf.sharding.device_set) == 2 and leaf.sharding.is_fully_replicated
     key = (id(world), mesh)
