@@ -257,7 +257,23 @@ def _sharded(fn, world, specs, agent, params, keys, chunk, parts: int, copies: i
     out = ahead(*args) if ahead is not None else _run_sharded(*args, **static)
     if size == n:
         return out
-    return jax.tree.map(lambda a: jax.lax.slice_in_dim(a, 0, n, axis=out_axis), out)
+    return cut_padding(out, n, out_axis)
+
+
+def cut_padding(out, n: int, axis: int):
+    """The first ``n`` rows along ``axis`` of every leaf of a sharded output,
+    cut on the host (each leaf gathered shard by shard) and put on the default device.
+
+    Not an eager ``lax.slice_in_dim``: on the sharded arrays that is one small
+    XLA program per leaf with an all-gather across the devices, and XLA:CPU
+    kills the process (``AwaitAndLogIfStuck``: abort after 40 s) when one
+    device waits that long at such a rendezvous: the devices' shards of a
+    rollout finish at different times (asynchronous dispatch, a loaded
+    machine), and the programs of several leaves in flight at once can take
+    every worker thread of the CPU client's pool while the other device's
+    halves wait for one. The host copy has no rendezvous."""
+    cut = (slice(None),) * axis + (slice(0, n),)
+    return jax.tree.map(lambda a: jax.device_put(np.asarray(a)[cut]), out)
 
 
 @partial(jax.jit, static_argnames=("fn", "agent", "widths", "mesh", "out_axis"),

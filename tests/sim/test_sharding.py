@@ -174,3 +174,24 @@ def test_world_is_copied_to_the_devices_once_per_world(small_benchmark):
     del world, copy, leaf
     gc.collect()
     assert key not in R._REPLICAS
+
+
+@two_devices
+def test_the_padding_is_cut_without_a_program_across_the_devices():
+    """A batch padded to equal shards is cut back on the host: no XLA program runs over both devices after the
+    rollout (an eager slice of each sharded output was one, with an all-gather at which XLA:CPU aborts the process
+    when one device waits 40 s for the other's shard)."""
+    from jax.sharding import NamedSharding, PartitionSpec as P
+
+    mesh = R.device_mesh(2)
+    tree = {"a": jnp.arange(24.0).reshape(6, 4), "b": jnp.arange(18).reshape(3, 6)}
+    sharded = {"a": jax.device_put(tree["a"], NamedSharding(mesh, P(R.AXIS))),
+               "b": jax.device_put(tree["b"], NamedSharding(mesh, P(None, R.AXIS)))}
+    clock = CompileClock().start()
+    cut_a = R.cut_padding({"a": sharded["a"]}, 5, 0)["a"]
+    cut_b = R.cut_padding({"b": sharded["b"]}, 4, 1)["b"]
+    clock.stop()
+    assert clock.names == []
+    np.testing.assert_array_equal(cut_a, np.asarray(tree["a"])[:5])
+    np.testing.assert_array_equal(cut_b, np.asarray(tree["b"])[:, :4])
+    assert len(cut_a.sharding.device_set) == 1 and len(cut_b.sharding.device_set) == 1
