@@ -38,7 +38,7 @@ import os
 from pathlib import Path
 
 from ignjax.agents.llm.agent import ASK, NO_QUESTIONS_LEFT, Decision
-from ignjax.agents.llm.client import ChatResult, ImagePart, LLMRequestError
+from ignjax.agents.llm.messages import ChatResult, ImagePart, LLMRequestError
 from ignjax.evaluate.outcomes import ACCOUNTING_COLUMNS
 from ignjax.fileio import atomic_write
 

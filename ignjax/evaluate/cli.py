@@ -228,7 +228,7 @@ def llm_settings(args, sections: dict, out_dir: Path):
 
 def _dry_run(args, agents, llm_agents, sim, llm, views, costs) -> int:
     """``--dry-run``: the upper bounds of :func:`ignjax.evaluate.dryrun.dry_run` per MLLM agent, as JSON lines."""
-    from ignjax.agents.llm.client import price
+    from ignjax.agents.llm.messages import price
     from ignjax.episodes.schema import read_episodes
     from ignjax.evaluate.dryrun import dry_run
 

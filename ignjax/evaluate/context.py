@@ -12,7 +12,8 @@ replies).
 from __future__ import annotations
 
 from ignjax.agents.llm.agent import Decision
-from ignjax.agents.llm.client import ChatClient, ImagePart
+from ignjax.agents.llm.client import ChatClient
+from ignjax.agents.llm.messages import ImagePart
 
 
 class DecisionContext:

@@ -8,7 +8,7 @@ import json
 
 from ignjax.agents.llm.agent import Decision, LLMAgent
 from ignjax.agents.llm.caption import CAPTION_CHARS, caption_request
-from ignjax.agents.llm.client import ChatRequest, ImagePart
+from ignjax.agents.llm.messages import ChatRequest, ImagePart
 from ignjax.agents.llm.config import LLMConfig
 from ignjax.protocol import LOCKED_COSTS
 from ignjax.sim import oracle_text as OT

@@ -94,7 +94,8 @@ import numpy as np
 
 from ignjax.agents.llm.agent import ASK, Decision, LLMAgent, compass_degrees
 from ignjax.agents.llm.cache import ResponseCache
-from ignjax.agents.llm.client import ChatClient, ChatRequest, ImagePart, LLMRequestError
+from ignjax.agents.llm.client import ChatClient
+from ignjax.agents.llm.messages import ChatRequest, ImagePart, LLMRequestError
 from ignjax.agents.llm.config import LLMConfig
 from ignjax.episodes.dataset import EpisodeSet
 from ignjax.errors import ConfigError

@@ -103,7 +103,7 @@ def outcome_rows(agent: str, records: list[dict], out, accounting: dict | None =
     MLLM agents, the per-episode ``accounting`` (:data:`ACCOUNTING_COLUMNS` -> (E,))
     priced at ``prices`` (``[llm].prices``; None: ``cost_usd`` NaN)."""
     if accounting:
-        from ignjax.agents.llm.client import price  # aiohttp only when asked
+        from ignjax.agents.llm.messages import price# aiohttp only when asked
     o = {k: np.asarray(getattr(out, k)) for k in ("final_distance", "final_euclidean", "min_distance", "path_length",
                                                   "steps", "stopped", "stop_reason", "n_questions", "n_refused",
                                                   "n_invalid", "trace_type", "trace_step", "trace_charged")}
@@ -141,7 +141,7 @@ def model_totals(rows: list[dict], prices: dict | None = None) -> dict[str, dict
     and ``per_episode``: for each of :data:`PER_EPISODE`, ``{"mean": ...,
     "max": ...}`` over all the agent's episodes (``cost_usd`` None without
     prices)."""
-    from ignjax.agents.llm.client import price  # aiohttp only when asked
+    from ignjax.agents.llm.messages import price# aiohttp only when asked
 
     by_agent: dict[str, list[dict]] = {}
     for r in rows:

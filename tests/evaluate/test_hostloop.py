@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from ignjax.agents.llm.agent import VlmAgent
-from ignjax.agents.llm.client import ReplayMissError
+from ignjax.agents.llm.messages import ReplayMissError
 from ignjax.agents.llm.config import LLMConfig
 from ignjax.agents.llm.serve import ScriptedServer
 from ignjax.episodes.dataset import load_benchmark

@@ -6,9 +6,11 @@ Modules:
 * :mod:`~ignjax.agents.llm.config`: :class:`LLMConfig`, the checked settings
   (endpoints, model, retries, concurrency, cache, prices; the API key is
   never a field, only the name of its environment variable);
-* :mod:`~ignjax.agents.llm.client`: :class:`ChatClient` (aiohttp), with
-  :class:`ChatRequest` / :class:`ImagePart` / :class:`ChatResult`,
-  least-loaded dispatch over endpoints, bounded concurrency, seeded retries
+* :mod:`~ignjax.agents.llm.messages`: :class:`ChatRequest` /
+  :class:`ImagePart` / :class:`ChatResult`, :class:`ClientStats`,
+  :func:`price` and the errors (plain data, no extra needed);
+* :mod:`~ignjax.agents.llm.client`: :class:`ChatClient` (aiohttp, the
+  ``llm`` extra): least-loaded dispatch over endpoints, bounded concurrency, seeded retries
   with backoff, structured output with fallback, key scrubbing, stats;
 * :mod:`~ignjax.agents.llm.cache`: :func:`request_hash` and the SQLite
   :class:`ResponseCache` (record / replay);
@@ -20,18 +22,10 @@ Modules:
 """
 
 from ignjax.agents.llm.cache import ResponseCache, request_hash
-from ignjax.agents.llm.client import (
-    ChatClient,
-    ChatRequest,
-    ChatResult,
-    ClientStats,
-    ImagePart,
-    LLMError,
-    LLMRequestError,
-    ReplayMissError,
-    price,
-)
+from ignjax.agents.llm.client import ChatClient
 from ignjax.agents.llm.config import LLMConfig
+from ignjax.agents.llm.messages import (ChatRequest, ChatResult, ClientStats, ImagePart, LLMError, LLMRequestError,
+                                        ReplayMissError, price)
 from ignjax.agents.llm.parse import parse_reply, validate
 
 

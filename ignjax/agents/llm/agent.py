@@ -48,7 +48,7 @@ import math
 
 from dataclasses import dataclass, field
 
-from ignjax.agents.llm.client import ChatRequest, ImagePart
+from ignjax.agents.llm.messages import ChatRequest, ImagePart
 from ignjax.protocol import view_hfov
 from ignjax.sim.views.compose import view_names
 

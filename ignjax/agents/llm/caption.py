@@ -27,7 +27,7 @@ label) is in these lines: only what the model wrote about the image.
 
 from __future__ import annotations
 
-from ignjax.agents.llm.client import ChatRequest, ImagePart
+from ignjax.agents.llm.messages import ChatRequest, ImagePart
 from ignjax.agents.llm.controller import clip
 from ignjax.sim.views.compose import view_names
 

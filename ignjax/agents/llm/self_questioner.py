@@ -53,7 +53,7 @@ import json
 from dataclasses import dataclass, field
 
 from ignjax.agents.llm.agent import ASK, STOP, Decision
-from ignjax.agents.llm.client import ChatRequest
+from ignjax.agents.llm.messages import ChatRequest
 from ignjax.agents.llm.controller import TEXT_CHARS, clip
 from ignjax.sim import types as T
 from ignjax.sim.oracle_text import refused_text

@@ -90,7 +90,7 @@ import dataclasses
 from ignjax.agents.llm.agent import (ASK, MOVE, MOVED_M, QUESTION_HELP, QUESTION_NAMES, STOP, Decision, LLMAgent,
                                      orientation_text)
 from ignjax.agents.llm.caption import describe_views
-from ignjax.agents.llm.client import ChatRequest
+from ignjax.agents.llm.messages import ChatRequest
 from ignjax.agents.llm.controller import RECOVERY_MOVES, TandemController, TandemMemory, clip, rear
 from ignjax.agents.llm.counterfactual import PROMPT as COUNTERFACTUAL_PROMPT
 from ignjax.agents.llm.counterfactual import counterfactual_error, with_counterfactuals

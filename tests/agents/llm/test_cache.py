@@ -9,7 +9,8 @@ import sqlite3
 import pytest
 
 from ignjax.agents.llm.cache import CACHE_FILE, ResponseCache, request_hash
-from ignjax.agents.llm.client import ChatClient, ChatRequest, ImagePart, LLMRequestError, ReplayMissError
+from ignjax.agents.llm.client import ChatClient
+from ignjax.agents.llm.messages import ChatRequest, ImagePart, LLMRequestError, ReplayMissError
 
 SCHEMA = {"type": "object", "properties": {"cell": {"type": "integer", "minimum": 1, "maximum": 64}},
           "required": ["cell"]}

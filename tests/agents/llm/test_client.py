@@ -13,7 +13,8 @@ import socket
 
 import pytest
 
-from ignjax.agents.llm.client import ChatClient, ChatRequest, ImagePart, LLMRequestError, price
+from ignjax.agents.llm.client import ChatClient
+from ignjax.agents.llm.messages import ChatRequest, ImagePart, LLMRequestError, price
 from ignjax.agents.llm.config import LLMConfig
 from ignjax.agents.llm.parse import parse_reply, validate
 from ignjax.errors import ConfigError, InputError

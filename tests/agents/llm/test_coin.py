@@ -21,7 +21,7 @@ import pytest
 from ignjax.agents.llm import self_questioner as SQ
 from ignjax.agents.llm.agent import ASK, MOVE, QUESTION_HELP, STOP, Decision
 from ignjax.agents.llm.catalog import get_llm_agent
-from ignjax.agents.llm.client import ImagePart
+from ignjax.agents.llm.messages import ImagePart
 from ignjax.agents.llm.config import LLMConfig
 from ignjax.agents.llm.controller import CORRECTIONS
 from ignjax.agents.llm.serve import ScriptedServer, request_text

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from ignjax.agents.llm.agent import MOVE, Decision
 from ignjax.agents.llm.catalog import get_llm_agent
-from ignjax.agents.llm.client import ImagePart
+from ignjax.agents.llm.messages import ImagePart
 from ignjax.agents.llm.graph_memory import LOOP_VISITS, MERGE_M, PlaceGraph, graph_text
 from ignjax.agents.llm.parse import parse_reply
 from ignjax.agents.llm.serve import ScriptedServer
