@@ -13,7 +13,8 @@ import numpy as np
 
 from ignjax.agents.llm.catalog import get_llm_agent, sim_overrides
 from ignjax.agents.llm.config import LLMConfig
-from ignjax.agents.llm.serve import ScriptedServer, scripted_reply
+from ignjax.agents.llm.scripted import scripted_reply
+from ignjax.agents.llm.serve import ScriptedServer
 from ignjax.episodes.dataset import load_benchmark
 from ignjax.evaluate.hostloop import run_llm_agent
 from ignjax.sim import types as T

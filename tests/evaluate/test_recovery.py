@@ -23,7 +23,8 @@ import pytest
 from ignjax.agents.llm.agent import NO_QUESTIONS_LEFT, VlmAgent
 from ignjax.agents.llm.catalog import get_llm_agent
 from ignjax.agents.llm.config import LLMConfig
-from ignjax.agents.llm.serve import ScriptedServer, scripted_reply
+from ignjax.agents.llm.scripted import scripted_reply
+from ignjax.agents.llm.serve import ScriptedServer
 from ignjax.episodes.dataset import load_benchmark
 from ignjax.evaluate.cli import main as evaluate_main
 from ignjax.evaluate.hostloop import run_llm_agent

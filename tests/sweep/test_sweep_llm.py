@@ -18,7 +18,8 @@ from pathlib import Path
 
 import pytest
 
-from ignjax.agents.llm.serve import ScriptedServer, scripted_reply
+from ignjax.agents.llm.scripted import scripted_reply
+from ignjax.agents.llm.serve import ScriptedServer
 from ignjax.studies.interaction import CONTENT_CLASSES, classify_question
 from ignjax.config import fingerprint, resolve
 from ignjax.errors import ConfigError

@@ -83,7 +83,7 @@ import time
 from dataclasses import dataclass
 from typing import Any, Callable
 
-from ignjax.agents.llm.parse import resolve_ref
+from ignjax.agents.llm.scripted import DATA_URL, cut_words, scripted_reply, texts_and_images
 from ignjax.errors import ConfigError
 from ignjax.errors.extras import optional_module
 
@@ -93,8 +93,6 @@ DEFAULT_MODEL = "ignjax-scripted"
 NAMED_FAULTS = ("slow", "drop", "malformed", "truncated")
 TOKENS_PER_IMAGE = 256
 ROLES = ("system", "user", "assistant", "tool", "developer")
-_DATA_URL = re.compile(r"^data:(?P<mime>[\w.+-]+/[\w.+-]+);base64,(?P<b64>.*)$", re.DOTALL)
-_WORDS = ("kitchen", "chair", "table", "left", "right", "door", "sofa", "lamp", "north", "window", "bed", "red")
 DESCRIPTION = ("ignjax scripted test double: replies are computed from the request text by a script, "
                "not by a language model")
 
@@ -176,123 +174,6 @@ class FaultSpec:
 
 
 # ---------------------------------------------------------------------------
-# replies
-# ---------------------------------------------------------------------------
-
-
-def schema_instance(schema: Any, rng: random.Random, root: Any = None, depth: int = 0) -> Any:
-    """A value valid under ``schema`` (the subset :mod:`~ignjax.agents.llm.parse`
-    checks), chosen by ``rng``."""
-    root = schema if root is None else root
-    if schema is True or schema is None or schema == {}:
-        return rng.choice(_WORDS)
-    schema = resolve_ref(schema, root)
-    if "const" in schema:
-        return schema["const"]
-    if schema.get("enum"):
-        return rng.choice(schema["enum"])
-    for key in ("anyOf", "oneOf"):
-        if schema.get(key):
-            merged = {k: v for k, v in schema.items() if k != key}
-            merged.update(resolve_ref(rng.choice(schema[key]), root))
-            return schema_instance(merged, rng, root, depth + 1)
-    if schema.get("allOf"):
-        merged = {k: v for k, v in schema.items() if k != "allOf"}
-        for sub in schema["allOf"]:
-            sub = resolve_ref(sub, root)
-            for k, v in sub.items():
-                if k == "properties":
-                    merged["properties"] = {**merged.get("properties", {}), **v}
-                elif k == "required":
-                    merged["required"] = list(dict.fromkeys(list(merged.get("required", [])) + list(v)))
-                else:
-                    merged.setdefault(k, v)
-        return schema_instance(merged, rng, root, depth + 1)
-    t = schema.get("type")
-    if isinstance(t, list):
-        non_null = [x for x in t if x != "null"]
-        t = rng.choice(non_null or t)
-    if t is None:
-        t = ("object" if "properties" in schema else "array" if "items" in schema
-             else "integer" if "minimum" in schema or "maximum" in schema else "string")
-    if t == "object":
-        props = schema.get("properties") or {}
-        required = set(schema.get("required") or ())
-        keys = [k for k in props if depth < 8 or k in required]
-        return {k: schema_instance(props[k], rng, root, depth + 1) for k in keys}
-    if t == "array":
-        lo = int(schema.get("minItems", 1))
-        hi = int(schema.get("maxItems", lo + 2))
-        n = lo if depth >= 8 else rng.randint(lo, max(lo, min(hi, lo + 3)))
-        return [schema_instance(schema.get("items", {}), rng, root, depth + 1) for _ in range(n)]
-    if t in ("integer", "number"):
-        lo, hi = schema.get("minimum"), schema.get("maximum")
-        xlo, xhi = schema.get("exclusiveMinimum"), schema.get("exclusiveMaximum")
-        if t == "integer":
-            lo = int(lo) if lo is not None else (int(xlo) + 1 if xlo is not None else 0)
-            hi = int(hi) if hi is not None else (int(xhi) - 1 if xhi is not None else lo + 100)
-            return rng.randint(lo, max(lo, hi))
-        lo = float(lo) if lo is not None else (float(xlo) + 1e-3 if xlo is not None else 0.0)
-        hi = float(hi) if hi is not None else (float(xhi) - 1e-3 if xhi is not None else lo + 100.0)
-        return min(max(round(rng.uniform(lo, hi), 3), lo), hi)
-    if t == "boolean":
-        return rng.random() < 0.5
-    if t == "null":
-        return None
-    s = " ".join(rng.choice(_WORDS) for _ in range(rng.randint(1, 3)))
-    lo, hi = int(schema.get("minLength", 0)), schema.get("maxLength")
-    s = s.ljust(lo, "x")
-    return s[: int(hi)] if hi is not None else s
-
-
-def request_text(body: dict) -> str:
-    """Every text part of a request's messages, one per line (what a reply policy reads)."""
-    return "\n".join(_texts_and_images(body)[0])
-
-
-def _texts_and_images(body: dict) -> tuple[list[str], list[tuple[str, bytes]]]:
-    texts, images = [], []
-    for m in body.get("messages", ()):
-        c = m.get("content")
-        if isinstance(c, str):
-            texts.append(c)
-        elif isinstance(c, list):
-            for p in c:
-                if p.get("type") == "text":
-                    texts.append(p.get("text", ""))
-                elif p.get("type") == "image_url":
-                    mm = _DATA_URL.match(p["image_url"]["url"])
-                    images.append((mm.group("mime"), base64.b64decode(mm.group("b64"))))
-    return texts, images
-
-
-def scripted_reply(body: dict, policy: Callable[[dict], str] | None = None) -> str:
-    """The reply text for a (checked) request body; see the module doc."""
-    if policy is not None:
-        return str(policy(body))
-    texts, images = _texts_and_images(body)
-    digest = hashlib.sha256(json.dumps([texts, [hashlib.sha256(b).hexdigest() for _, b in images],
-                                        body.get("seed")]).encode()).hexdigest()
-    rng = random.Random(int(digest[:16], 16))
-    rf = body.get("response_format") or {}
-    if rf.get("type") == "json_schema":
-        return json.dumps(schema_instance(rf["json_schema"]["schema"], rng))
-    last_user = ""
-    for m in body.get("messages", ()):
-        if m.get("role") == "user":
-            c = m.get("content")
-            last_user = c if isinstance(c, str) else " ".join(p.get("text", "") for p in c if p.get("type") == "text")
-    if rf.get("type") == "json_object" or re.search(r"\bjson\b", last_user, re.IGNORECASE):
-        return json.dumps({"reply": f"scripted {digest[:8]}", "choice": rng.randint(1, 64)})
-    return f"Scripted reply {digest[:8]}: {rng.choice(_WORDS)} {rng.choice(_WORDS)} (test double, not a model)."
-
-
-def _cut(text: str, max_words: int) -> str:
-    m = list(re.finditer(r"\S+", text))
-    return text[: m[max_words - 1].end()] if len(m) > max_words else text
-
-
-# ---------------------------------------------------------------------------
 # request checks
 # ---------------------------------------------------------------------------
 
@@ -335,7 +216,7 @@ def _check_request(body: Any, model: str) -> None:
             url = iu.get("url") if isinstance(iu, dict) else None
             if not isinstance(url, str):
                 raise _Reject(400, f"{where}.image_url.url must be a string")
-            mm = _DATA_URL.match(url)
+            mm = DATA_URL.match(url)
             if not mm:
                 raise _Reject(400, f"{where}.image_url.url must be a data:<mime>;base64,... URL "
                                    "(the scripted server fetches nothing)")
@@ -531,7 +412,7 @@ class ScriptedServer:
             return _error(e.status, e.message, e.kind)
         with self._lock:
             self._last_request = body
-            self._last_images = _texts_and_images(body)[1]
+            self._last_images = texts_and_images(body)[1]
             self._history.append(body)
         if self.reject_response_format and "response_format" in body:
             self._count(400)
@@ -585,12 +466,12 @@ class ScriptedServer:
         finish = "stop"
         mt = body.get("max_tokens")
         if mt is not None:
-            cut = _cut(content, int(mt))
+            cut = cut_words(content, int(mt))
             if cut != content:
                 content, finish = cut, "length"
         if fault == "truncated":
             content, finish = content[: max(1, len(content) // 2)], "length"
-        texts, images = _texts_and_images(body)
+        texts, images = texts_and_images(body)
         prompt_tokens = sum(len(t.split()) for t in texts) + TOKENS_PER_IMAGE * len(images)
         completion_tokens = len(content.split())
         digest = hashlib.sha256(json.dumps(body, sort_keys=True).encode()).hexdigest()

@@ -22,7 +22,8 @@ import pytest
 from ignjax.agents.llm.caption import CAPTION_SYSTEM, NO_CAPTION, caption_reply
 from ignjax.agents.llm.catalog import get_llm_agent
 from ignjax.agents.llm.config import LLMConfig
-from ignjax.agents.llm.serve import ScriptedServer, request_text
+from ignjax.agents.llm.scripted import request_text
+from ignjax.agents.llm.serve import ScriptedServer
 from ignjax.episodes.dataset import load_benchmark
 from ignjax.evaluate.hostloop import run_llm_agent
 from ignjax.scenes import vocab

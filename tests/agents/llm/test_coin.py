@@ -24,7 +24,8 @@ from ignjax.agents.llm.catalog import get_llm_agent
 from ignjax.agents.llm.messages import ImagePart
 from ignjax.agents.llm.config import LLMConfig
 from ignjax.agents.llm.controller import CORRECTIONS
-from ignjax.agents.llm.serve import ScriptedServer, request_text
+from ignjax.agents.llm.scripted import request_text
+from ignjax.agents.llm.serve import ScriptedServer
 from ignjax.agents.llm.tandem import Tandem, TandemMemory
 from ignjax.episodes.dataset import load_benchmark
 from ignjax.evaluate.hostloop import run_llm_agent

@@ -21,7 +21,8 @@ from pathlib import Path
 import pytest
 
 from ignjax.agents.llm.parse import validate
-from ignjax.agents.llm.serve import DEFAULT_MODEL, FaultSpec, schema_instance
+from ignjax.agents.llm.scripted import schema_instance
+from ignjax.agents.llm.serve import DEFAULT_MODEL, FaultSpec
 from ignjax.agents.llm.vllm_server import listening_ports
 from ignjax.errors import ConfigError
 

@@ -22,7 +22,8 @@ import pytest
 from ignjax.agents.llm.agent import ASK, MOVE, STOP, Decision, compass_degrees, orientation_text
 from ignjax.agents.llm.catalog import LLM_AGENTS, get_llm_agent
 from ignjax.agents.llm.config import LLMConfig
-from ignjax.agents.llm.serve import ScriptedServer, request_text, scripted_reply
+from ignjax.agents.llm.scripted import request_text, scripted_reply
+from ignjax.agents.llm.serve import ScriptedServer
 from ignjax.agents.llm.controller import CORRECTIONS
 from ignjax.agents.llm.tandem import RECOVERY_MOVES, TandemMemory
 from ignjax.episodes.dataset import load_benchmark
