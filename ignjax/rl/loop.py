@@ -10,7 +10,6 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-import jax
 import numpy as np
 
 from ignjax.episodes.dataset import load_benchmark
@@ -46,8 +45,7 @@ def start_state(cfg: TrainConfig, trainer: Trainer, out: Path, resume: bool):
         return shared, rows, 0
     found = C.read_record(last)
     C.check_record(found, C.record(cfg.sim, policy_record(cfg), cfg.fingerprint(), found.get("update", 0)), last)
-    like = jax.eval_shape(lambda: trainer.init(cfg.run.seed))
-    shared, rows = trainer.place(*C.load(last, like))
+    shared, rows = trainer.place(*C.load(last, trainer.shapes()))
     return shared, rows, int(found["update"])
 
 

@@ -279,6 +279,18 @@ class Trainer:
         self.mesh = device_mesh(self.parts)
         self.envp = dataclasses.replace(envp, world=replicate_world(envp.world, self.mesh))
 
+    def shapes(self) -> tuple[Shared, Rows]:
+        """The shapes and dtypes of :meth:`init`'s state (nothing computed): a checkpoint's layout."""
+        def state():
+            key = jax.random.key(0)
+            params = init_params(self.policy, key, self.env.observation_space().shape[0])
+            shared = Shared(params=params, opt_state=make_optimizer(self.ppo).init(params), update=jnp.int32(0),
+                            key=jax.random.key_data(key))
+            keys = jax.random.key_data(jax.random.split(key, self.ppo.num_envs))
+            return shared, _Init(self.env, self.policy, self.chunk)(self.envp, (keys, keys))
+
+        return jax.eval_shape(state)
+
     def init(self, seed: int) -> tuple[Shared, Rows]:
         """The state before the first update: weights, Adam's state and B fresh episodes, all drawn from ``seed``."""
         key = jax.random.key(seed)
