@@ -14,6 +14,7 @@ import numpy as np
 
 from ignjax.episodes.dataset import load_benchmark
 from ignjax.rl import checkpoint as C
+from ignjax.rl import curve as cli
 from ignjax.rl.env import make
 from ignjax.rl.policy import Policy
 from ignjax.rl.ppo import Trainer, train_calls
@@ -51,8 +52,6 @@ def start_state(cfg: TrainConfig, trainer: Trainer, out: Path, resume: bool):
 
 def train(cfg: TrainConfig, out: Path, episodes: Path, resume: bool, progress: bool) -> Path:
     """Run the updates left; write the curve after every call and a checkpoint every ``checkpoint_every``."""
-    from ignjax.rl import train as cli
-
     ppo = cfg.ppo
     trainer = make_trainer(cfg, episodes)
     shared, rows, start = start_state(cfg, trainer, out, resume)

@@ -25,11 +25,9 @@ Needs the ``rl`` extra (flax, optax): without it the command prints the
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import shutil
 import sys
-import time
 from pathlib import Path
 
 from ignjax.cache import add_cache_arguments, apply_cache_arguments
@@ -37,11 +35,6 @@ from ignjax.errors import ConfigError, IgnjaxError, InputError
 from ignjax.errors.extras import require_extra
 from ignjax.fileio import atomic_write
 from ignjax.rl import trainconfig as TC
-
-COLUMNS = ("update", "steps", "wall_s", "episodes", "return", "success", "questions", "length", "reward",
-           "loss_policy", "loss_value", "entropy", "approx_kl", "lr")
-"""The columns of ``curve.csv``."""
-
 
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python -m ignjax.rl.train", description=__doc__.split("\n\n")[0])
@@ -126,48 +119,6 @@ def training_episodes(cfg: TC.TrainConfig, out: Path) -> Path:
     return path
 
 
-def read_curve(path: Path, upto: int) -> list[dict]:
-    """The curve's rows of updates 1 .. ``upto`` (a resumed run drops what came after its checkpoint)."""
-    if not path.is_file():
-        return []
-    with path.open() as fh:
-        return [row for row in csv.DictReader(fh) if int(row["update"]) <= upto]
-
-
-def write_curve(out: Path, rows: list[dict]) -> None:
-    """``curve.csv`` and ``curve.png`` (return and success of the ended episodes against environment steps)."""
-    import io
-
-    buf = io.StringIO()
-    w = csv.DictWriter(buf, COLUMNS, lineterminator="\n")
-    w.writeheader()
-    w.writerows(rows)
-    atomic_write(out / "curve.csv", buf.getvalue())
-    if rows:
-        plot_curve(out / "curve.png", rows)
-
-
-def plot_curve(path: Path, rows: list[dict]) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    steps = [float(r["steps"]) / 1e6 for r in rows]
-    fig, axes = plt.subplots(1, 3, figsize=(12, 3.2))
-    for ax, key, label in zip(axes, ("return", "success", "questions"),
-                              ("return (WSR@1.5)", "success rate", "questions / episode")):
-        ax.plot(steps, [float(r[key]) for r in rows], lw=1)
-        ax.set_xlabel("environment steps (M)")
-        ax.set_ylabel(label)
-        ax.grid(alpha=0.3)
-    fig.tight_layout()
-    tmp = path.with_name(path.name + ".tmp.png")
-    fig.savefig(tmp, dpi=100, metadata={"Software": None})
-    plt.close(fig)
-    tmp.replace(path)
-
-
 def run(cfg: TC.TrainConfig, resume: bool = False, force: bool = False, progress: bool = True) -> Path:
     """Train; returns the run folder (see the module docstring)."""
     from ignjax.rl import loop
@@ -177,7 +128,7 @@ def run(cfg: TC.TrainConfig, resume: bool = False, force: bool = False, progress
     return loop.train(cfg, out, training_episodes(cfg, out), resume, progress)
 
 
-__all__ = ["COLUMNS", "main", "prepare_folder", "read_curve", "run", "training_episodes", "write_curve"]
+__all__ = ["main", "prepare_folder", "run", "training_episodes"]
 
 if __name__ == "__main__":
     from ignjax.devices import configure_cpu_devices
