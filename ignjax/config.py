@@ -24,12 +24,9 @@ import dataclasses
 import functools
 import hashlib
 import json
-import math
 import os
 import textwrap
-import tomllib
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, ClassVar
 
 from ignjax.agents import registry
@@ -40,6 +37,11 @@ from ignjax.arrays import field_docs, parse_assignment
 from ignjax.episodes.difficulty import validate_alpha, validate_thresholds
 from ignjax.errors import ConfigError
 from ignjax.protocol import DIFFICULTY_ALPHA, DIFFICULTY_THRESHOLDS, LOCKED_COSTS, SUCCESS_REQUIRES_STOP, SUCCESS_THRESHOLDS
+from ignjax.settings import check_fields as _check_fields
+from ignjax.settings import check_value as _check_value
+from ignjax.settings import line_of as _line_of
+from ignjax.settings import load_toml, sections_toml
+from ignjax.settings import toml_value as _toml_value
 from ignjax.sim.types import SimConfig
 from ignjax.sim.views.config import ViewConfig
 from ignjax.studies.cost_sensitivity import validate_costs
@@ -47,50 +49,6 @@ from ignjax.studies.cost_sensitivity import validate_costs
 # ---------------------------------------------------------------------------
 # value checks shared by every section
 # ---------------------------------------------------------------------------
-
-
-def _check_value(key: str, value: Any, default: Any, where: str | None) -> Any:
-    """``value`` checked against the type of ``default`` (the field's default)
-    and normalised: ints given for floats become floats, lists become tuples."""
-    if isinstance(default, bool):
-        if not isinstance(value, bool):
-            raise ConfigError(where, key, f"expected true or false, got {value!r}")
-        return value
-    if isinstance(default, int):
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise ConfigError(where, key, f"expected an integer, got {value!r}")
-        return value
-    if isinstance(default, float):
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise ConfigError(where, key, f"expected a finite number, got {value!r}")
-        return float(value)
-    if isinstance(default, str):
-        if not isinstance(value, str):
-            raise ConfigError(where, key, f"expected a string, got {value!r}")
-        return value
-    if isinstance(default, tuple):
-        if not isinstance(value, (list, tuple)):
-            raise ConfigError(where, key, f"expected a list, got {value!r}")
-        if default and all(isinstance(v, int) and not isinstance(v, bool) for v in default):
-            if any(isinstance(v, bool) or not isinstance(v, int) for v in value):
-                raise ConfigError(where, key, f"expected integers, got {list(value)!r}")
-            return tuple(value)
-        if default and isinstance(default[0], (int, float)) and not isinstance(default[0], bool):
-            for v in value:
-                if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-                    raise ConfigError(where, key, f"expected finite numbers, got {list(value)!r}")
-            return tuple(float(v) for v in value)
-        if default and isinstance(default[0], str) and not all(isinstance(v, str) for v in value):
-            raise ConfigError(where, key, f"expected strings, got {list(value)!r}")
-        return tuple(value)
-    return value
-
-
-def _check_fields(obj, section: str) -> None:
-    """Type-check and normalise every field of a (frozen) section in place."""
-    for f in dataclasses.fields(obj):
-        value = _check_value(f"{section}.{f.name}", getattr(obj, f.name), f.default, None)
-        object.__setattr__(obj, f.name, value)
 
 
 def _check_agent(name: str, key: str) -> None:
@@ -480,33 +438,6 @@ def _check_names(section: str, items: Any, where: str, text: str | None = None) 
 # ---------------------------------------------------------------------------
 
 
-def _line_of(text: str, section: str, key: str | None = None) -> int | None:
-    """Line (1-based) of ``[section]``, or of ``key = ...`` inside it."""
-    inside = False
-    for i, line in enumerate(text.splitlines(), 1):
-        s = line.strip()
-        if s.startswith("["):
-            inside = s.split("#", 1)[0].strip() == f"[{section}]"
-            if inside and key is None:
-                return i
-        elif inside and key is not None and s.split("=", 1)[0].strip().strip('"\'') == key:
-            return i
-    return None
-
-
-def load_toml(path: str | os.PathLike) -> tuple[dict, str]:
-    """Read a sweep TOML file. Returns (mapping, text); errors name the file and line."""
-    p = Path(path)
-    if not p.is_file():
-        raise ConfigError(str(p), "--config", "file not found")
-    text = p.read_text(encoding="utf-8")
-    try:
-        return tomllib.loads(text), text
-    except tomllib.TOMLDecodeError as e:
-        line = getattr(e, "lineno", None)
-        raise ConfigError(f"{p}:{line}" if line else str(p), "toml", f"malformed TOML: {e}") from None
-
-
 def _check_names_agent(name: str, items: Any, where: str, text: str | None) -> None:
     if not isinstance(items, dict):
         raise ConfigError(where, f"agents.{name}", "must be a table of parameter = value")
@@ -599,20 +530,6 @@ def fingerprint(cfg: SweepConfig, studies: list[str]) -> str:
 # ---------------------------------------------------------------------------
 
 
-def _toml_value(v: Any) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, float) and not math.isfinite(v):
-        return ("inf" if v > 0 else "-inf") if v == v else "nan"
-    if isinstance(v, (int, float)):
-        return repr(v)
-    if isinstance(v, str):
-        return json.dumps(v)
-    if isinstance(v, dict):
-        return "{" + ", ".join(f"{json.dumps(k)} = {_toml_value(x)}" for k, x in v.items()) + "}"
-    return "[" + ", ".join(_toml_value(x) for x in v) + "]"
-
-
 def to_toml(cfg: SweepConfig, header: str = "") -> str:
     """``cfg`` as a TOML file: every table and key, each key under its description."""
     out = [f"# {line}".rstrip() for line in header.splitlines()]
@@ -630,15 +547,7 @@ def to_toml(cfg: SweepConfig, header: str = "") -> str:
                     out += wrap(docs.get(key, ""))
                     out.append(f"{key} = {_toml_value(value)}")
             continue
-        docs = field_docs(type(section))
-        if out:
-            out.append("")
-        out.append(f"[{name}]")
-        for f in dataclasses.fields(section):
-            out += textwrap.wrap(docs.get(f.name, "").replace("``", "`"), 110, initial_indent="# ", subsequent_indent="# ")
-            value = getattr(section, f.name)
-            # TOML has no null: a setting that is unset by default is shown commented out
-            out.append(f"# {f.name} = (unset)" if value is None else f"{f.name} = {_toml_value(value)}")
+        sections_toml({name: section}, out)
     return "\n".join(out) + "\n"
 
 

@@ -8,7 +8,7 @@ import ast
 from pathlib import Path
 
 PKG = Path(__file__).resolve().parents[1] / "ignjax"
-LAYER = {"__main__": 6, "protocol": 0, "arrays": 0, "cache": 0, "errors": 0, "fileio": 0, "data": 0, "devices": 0, "scenes": 1, "episodes": 2, "sim": 2,
+LAYER = {"__main__": 6, "protocol": 0, "arrays": 0, "cache": 0, "errors": 0, "fileio": 0, "data": 0, "devices": 0, "settings": 0, "scenes": 1, "episodes": 2, "sim": 2,
          "agents": 3, "evaluate": 4, "studies": 5, "rl": 5, "config": 6, "sweep": 6, "bench": 6, "build": 6, "view": 6}
 FORBIDDEN = {("sim", "episodes")}  # episodes uses the simulator's EpisodeSpec; sim uses nothing of episodes
 

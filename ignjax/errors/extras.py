@@ -11,7 +11,7 @@ import importlib
 from ignjax.errors import IgnjaxError
 
 EXTRAS = {"llm": "MLLM agents and the scripted model server", "render": "MuJoCo Warp's batch renderer",
-          "rl": "the Gymnasium vector-environment adapter of the RL environment"}
+          "rl": "the Gymnasium vector-environment adapter and the PPO trainer of the RL environment"}
 """The optional parts of the install (``pip install "ignjax[NAME]"``) and what each one is for."""
 
 

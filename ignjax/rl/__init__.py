@@ -11,6 +11,8 @@ devices, and a Gymnasium vector-environment adapter (``pip install
 * :mod:`ignjax.rl.spaces` - :class:`Box`, :class:`Discrete`.
 * :mod:`ignjax.rl.vector` - :class:`VecEnv`: B environments sharded over the devices.
 * :mod:`ignjax.rl.gym` - :class:`IgnjaxVectorEnv` (Gymnasium's ``VectorEnv``).
+* :mod:`ignjax.rl.train` - ``python -m ignjax.rl.train``, PPO (``trainconfig``, ``policy``, ``ppo``,
+  ``checkpoint``, ``loop``; the ``rl`` extra's flax and optax).
 """
 
 from ignjax.rl.actions import action_names, n_actions
