@@ -1,7 +1,8 @@
-"""Writing output files so that a reader never sees a partial one."""
+"""Writing output files so that a reader never sees a partial one, and checking them by their SHA-256."""
 
 from __future__ import annotations
 
+import hashlib
 import os
 from pathlib import Path
 
@@ -39,4 +40,13 @@ def remove_leftover_temporaries(folder: str | os.PathLike) -> int:
     return n
 
 
-__all__ = ["atomic_write", "remove_leftover_temporaries"]
+def file_sha256(path: str | os.PathLike) -> str:
+    """The SHA-256 of a file's bytes, hex, read a megabyte at a time."""
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+__all__ = ["atomic_write", "file_sha256", "remove_leftover_temporaries"]

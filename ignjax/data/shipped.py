@@ -18,12 +18,12 @@ from __future__ import annotations
 
 import functools
 import gzip
-import hashlib
 import json
 import math
 from pathlib import Path
 
 from ignjax.errors import InputError
+from ignjax.fileio import file_sha256
 
 FOLDER = Path(__file__).resolve().parent / "benchmark"
 """The shipped benchmark's folder (the houses, their manifest and the episode files)."""
@@ -54,14 +54,6 @@ def recorded_hashes() -> dict[str, str]:
             raise _damaged(HASHES, f"line {i} is not '<sha256>  <file name>'")
         out[name] = digest
     return out
-
-
-def file_sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
 
 
 def mismatches(folder: Path, hashes: dict[str, str]) -> list[str]:
@@ -140,4 +132,4 @@ def shipped_episodes() -> Path:
 
 
 __all__ = ["EPISODES", "EPISODE_SEED", "FOLDER", "HASHES", "LABEL", "REBUILD", "SCENE_COUNT", "SCENE_SEED", "SUBSET",
-           "describe", "episode_differences", "file_sha256", "mismatches", "recorded_hashes", "shipped_episodes"]
+           "describe", "episode_differences", "mismatches", "recorded_hashes", "shipped_episodes"]

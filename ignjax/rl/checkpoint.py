@@ -22,6 +22,7 @@ from pathlib import Path
 
 import jax
 import numpy as np
+import orbax.checkpoint as ocp
 
 from ignjax import __version__
 from ignjax.errors import InputError
@@ -31,7 +32,6 @@ from ignjax.rl.actions import action_names
 from ignjax.rl.obs import obs_layout
 from ignjax.sim import types as T
 
-ocp = optional_module("orbax.checkpoint", "rl")
 serialization = optional_module("flax.serialization", "rl")
 
 FORMAT = 1

@@ -40,7 +40,7 @@ from ignjax.rl.env import Env, EnvState
 from ignjax.rl.params import EnvParams
 from ignjax.rl.policy import Policy, init_params, sequence
 from ignjax.rl.trainconfig import PPOConfig
-from ignjax.rl.vector import _parts
+from ignjax.rl.vector import env_parts
 from ignjax.sim.rollout import AXIS, ROLLOUT_COMPILER_OPTIONS, device_mesh, replicate_world
 
 optax = optional_module("optax", "rl")
@@ -271,7 +271,7 @@ class Trainer:
                  chunk: int | None = None):
         env.check(envp)
         self.env, self.policy, self.ppo, self.chunk = env, policy, ppo, chunk
-        self.parts = _parts(ppo.num_envs, parts)
+        self.parts = env_parts(ppo.num_envs, parts)
         per_device = ppo.num_envs // self.parts
         if per_device % ppo.minibatches:
             raise ConfigError(None, "ppo.minibatches", f"must divide the {per_device} environments of each of the "

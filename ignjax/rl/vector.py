@@ -85,7 +85,7 @@ class _RandomSteps:
         return state, totals
 
 
-def _parts(num_envs: int, parts: int | None) -> int:
+def env_parts(num_envs: int, parts: int | None) -> int:
     """Devices to shard ``num_envs`` rows over: ``parts`` (it must divide them), or the most devices that divide them."""
     if parts:
         p = batch_parts(num_envs, parts)
@@ -113,7 +113,7 @@ class VecEnv:
         if isinstance(num_envs, bool) or not isinstance(num_envs, int) or num_envs < 1:
             raise ConfigError(None, "rl.num_envs", f"must be a positive integer, got {num_envs!r}")
         self.env, self.num_envs, self.chunk = env, num_envs, chunk
-        self.parts = _parts(num_envs, parts)
+        self.parts = env_parts(num_envs, parts)
         self.mesh = device_mesh(self.parts)
 
     def _params(self, params: EnvParams) -> EnvParams:
@@ -139,4 +139,4 @@ class VecEnv:
                     mesh=self.mesh)
 
 
-__all__ = ["VecEnv"]
+__all__ = ["VecEnv", "env_parts"]

@@ -32,6 +32,19 @@ def as_array(x, name: str, *, ndim: int | tuple[int, ...] | None = None, last: i
     return a
 
 
+def class_counts(cls: np.ndarray, difficulty: np.ndarray, n_classes: int = 4):
+    """``(known, counts, counts_by_difficulty)`` of per-question class codes
+    (-1: unknown): which codes are known, each class's count, and the (3,
+    n_classes) counts per difficulty bin (questions of an unknown bin, -1,
+    left out there)."""
+    known = cls >= 0
+    counts = np.bincount(cls[known], minlength=n_classes)
+    by_d = np.zeros((3, n_classes), np.int64)
+    kd = known & (difficulty >= 0)
+    np.add.at(by_d, (difficulty[kd], cls[kd]), 1)
+    return known, counts, by_d
+
+
 def new_figure(nrows: int = 1, ncols: int = 1, size=(6.0, 4.0)):
     """A matplotlib figure (Agg canvas, no pyplot state) and its axes array."""
     fig = Figure(figsize=size)

@@ -99,7 +99,7 @@ from ignjax.errors import ConfigError, InputError
 from ignjax.evaluate.outcomes import parse_trace
 from ignjax.protocol import BIN_NAMES
 from ignjax.scenes.vocab import ROOM_DISPLAY, ROOM_LABELS
-from ignjax.studies._common import as_array
+from ignjax.studies._common import as_array, class_counts
 from ignjax.studies.locations import UNKNOWN
 
 CONTENT_CLASSES: tuple[str, ...] = ("route", "goal_room_position", "room_relations", "unclassified")
@@ -296,12 +296,7 @@ def type3_content(events: dict, texts: dict | None, *, reason: str = "") -> dict
                 "classes": CONTENT_CLASSES, "n": int(sel.sum())}
     txt = [str(texts.get((int(e), int(s)), "") or "") for e, s in zip(ep, st)]
     cls = np.asarray([classify_question(t) if t.strip() else UNKNOWN for t in txt], np.int64)
-    known = cls >= 0
-    counts = np.bincount(cls[known], minlength=4)
-    diff = np.asarray(events["difficulty"])[ep]
-    by_d = np.zeros((3, 4), np.int64)
-    kd = known & (diff >= 0)
-    np.add.at(by_d, (diff[kd], cls[kd]), 1)
+    known, counts, by_d = class_counts(cls, np.asarray(events["difficulty"])[ep])
     n3 = counts[:3].sum()
     return {"applicable": True, "episode": ep, "step": st, "text": txt, "cls": cls, "classes": CONTENT_CLASSES,
             "counts": counts, "n_without_text": int((~known).sum()), "n": int(len(ep)),

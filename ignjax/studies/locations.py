@@ -52,7 +52,7 @@ import numpy as np
 from scipy import ndimage
 
 from ignjax.errors import ConfigError, InputError
-from ignjax.studies._common import as_array
+from ignjax.studies._common import as_array, class_counts
 
 LOCATION_CLASSES: tuple[str, ...] = ("corridor", "junction", "dead_end", "room")
 CORRIDOR, JUNCTION, DEAD_END, ROOM = range(4)
@@ -301,12 +301,7 @@ def type3_locations(grids, poses, events: dict, *, scene_index=None, room_labels
         raise InputError(None, "poses", f"shape {pz.shape} does not cover the events (episode {ep.max()}, step {st.max()})")
     glist, labels, sidx = _grid_lists(grids, pz.shape[0], scene_index, room_labels)
     cls, width, sectors = _classify_at(glist, labels, sidx, pz, ep, st, params, mask)
-    known = cls >= 0
-    counts = np.bincount(cls[known], minlength=4)
-    diff = np.asarray(events["difficulty"])[ep]
-    by_d = np.zeros((3, 4), np.int64)
-    kd = known & (diff >= 0)
-    np.add.at(by_d, (diff[kd], cls[kd]), 1)
+    known, counts, by_d = class_counts(cls, np.asarray(events["difficulty"])[ep])
     return {"episode": ep, "step": st, "cls": cls, "width": width, "sectors": sectors, "classes": LOCATION_CLASSES,
             "counts": counts, "n_unknown": int((~known).sum()),
             "fractions": counts / counts.sum() if counts.sum() else np.full(4, np.nan), "counts_by_difficulty": by_d}

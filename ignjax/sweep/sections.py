@@ -22,11 +22,12 @@ from ignjax.agents.policies import DEADLINE_STEPS
 from ignjax.config import SweepConfig
 from ignjax.evaluate import metrics as M
 from ignjax.fileio import atomic_write
-from ignjax.protocol import BIN_NAMES, LOCKED_COSTS
+from ignjax.protocol import BIN_NAMES, LOCKED_COSTS, QUESTION_TYPES
+from ignjax.sim import geometry as G
 from ignjax.sweep.report import (VIEWER_FILE, study_analysis, study_costs, study_derive_costs, study_difficulty,
                                  study_eval)
 
-TYPE_WORDS = ("appearance", "region", "route hint", "confirmation")
+TYPE_WORDS = tuple("route hint" if name == "route" else name for name in QUESTION_TYPES)
 """How the report names question types 1..4 (:data:`ignjax.protocol.QUESTION_TYPES`, the route question's
 answer being a hint)."""
 
@@ -144,8 +145,8 @@ def shortest_move(sim: dict) -> float:
     """Length (m) of the shortest unobstructed MOVE: to the floor point seen at the centre of the grid's bottom
     row in the middle of the view (the executor's waypoint of cell (4-5, 1))."""
     width, height = sim["image_size"]
-    f = (width / 2) / math.tan(math.radians(sim["hfov"]) / 2)
-    return sim["eye_height"] * f / (height / 2 - height / 16)
+    ray = G.pixel_ray(G.intrinsics(width, height, math.radians(sim["hfov"])), G.grid_to_pixel(4.5, 1, width, height))
+    return sim["eye_height"] / float(ray[1])  # camera frame: y down, z forward (ray's z is 1)
 
 
 def privileged_note(name: str, row: dict, sim: dict) -> str:

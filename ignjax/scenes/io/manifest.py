@@ -15,24 +15,16 @@ atomically.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 from pathlib import Path
 
 from ignjax.errors import SceneError
+from ignjax.fileio import file_sha256
 from ignjax.scenes.model import Scene
 
 MANIFEST_FORMAT = "ignjax-scenes"
 MANIFEST_VERSION = 1
-
-
-def file_sha256(path: str | os.PathLike) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for chunk in iter(lambda: f.read(1 << 20), b""):
-            h.update(chunk)
-    return h.hexdigest()
 
 
 def manifest_entry(scene: Scene, file: Path) -> dict:
