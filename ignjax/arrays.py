@@ -15,7 +15,7 @@ import numpy as np
 from ignjax.errors import ConfigError
 
 
-def pytree_dataclass(cls=None, *, static: tuple[str, ...] = ()):
+def pytree_dataclass(cls=None, *, static: tuple[str, ...] = (), untraced: tuple[str, ...] = ()):
     """Make ``cls`` a frozen dataclass registered as a JAX pytree.
 
     Every field is a pytree leaf (traced, batched by ``vmap``) except those
@@ -25,6 +25,11 @@ def pytree_dataclass(cls=None, *, static: tuple[str, ...] = ()):
     made a frozen one. Use as ``@pytree_dataclass`` or
     ``@pytree_dataclass(static=("config",))``; change instances with
     :func:`dataclasses.replace`.
+
+    ``untraced`` names static fields that traced code never reads
+    (host-side objects kept beside the arrays): a compiled program's disk
+    key leaves them out (:mod:`ignjax.cache.programs`), so they need no
+    faithful description.
     """
 
     def wrap(c):
@@ -34,8 +39,11 @@ def pytree_dataclass(cls=None, *, static: tuple[str, ...] = ()):
         unknown = set(static) - set(names)
         if unknown:
             raise TypeError(f"{c.__name__}: static fields {sorted(unknown)} are not fields")
-        return jax.tree_util.register_dataclass(
-            c, data_fields=[n for n in names if n not in static], meta_fields=[n for n in names if n in static])
+        if set(untraced) - set(static):
+            raise TypeError(f"{c.__name__}: untraced fields {sorted(set(untraced) - set(static))} are not static")
+        meta = [n for n in names if n in static]
+        c.__pytree_meta__, c.__untraced__ = tuple(meta), tuple(untraced)
+        return jax.tree_util.register_dataclass(c, data_fields=[n for n in names if n not in static], meta_fields=meta)
 
     return wrap if cls is None else wrap(cls)
 

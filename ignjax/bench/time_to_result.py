@@ -19,8 +19,9 @@ scenes' tables, goal fields and the world, outside compiling), ``compile_s``
 persistent cache: JAX's compile events, :mod:`ignjax.cache.clock`) and
 ``run_s`` (the rest of the process's wall time ``total_s``: simulating,
 writing outputs, and Python's start and imports), with ``programs`` (programs
-obtained), ``cache_hits`` (of them loaded from the compilation cache) and
-``compiled``. ``same_outputs`` says whether the cold and warm runs wrote the
+obtained), ``cache_hits`` (of them loaded from a cache), ``whole`` (of the
+hits, loaded whole from the program store, :mod:`ignjax.cache.programs`:
+no tracing or lowering) and ``compiled``. ``same_outputs`` says whether the cold and warm runs wrote the
 same bytes (every output file but the checkpoints' metadata, which orbax
 stamps with the time).
 """
@@ -75,7 +76,7 @@ def _child(command: str, argv: list[str], out: Path) -> dict:
         raise SystemExit(f"unknown command {command!r}: one of {', '.join([*COMMANDS, 'in_loop'])}")
     clock.stop()
     return {**split(phase_spans("load"), clock.spans), "programs": clock.programs, "cache_hits": clock.cache_hits,
-            "compiled": clock.programs - clock.cache_hits}
+            "whole": clock.whole, "compiled": clock.programs - clock.cache_hits}
 
 
 def _digests(folder: Path) -> dict:
@@ -113,7 +114,8 @@ def cold_and_warm(command: str, argv: list[str], folder: Path, env: dict | None 
         runs[state] = r = run_fresh(command, argv, folder / "cache", folder / state, env)
         if log:
             log(f"  {name or command:17s} {state}: {r['total_s']:6.1f} s = load {r['load_s']:5.1f} + compile "
-                f"{r['compile_s']:5.1f} + run {r['run_s']:5.1f}; {r['programs']} programs, {r['compiled']} compiled")
+                f"{r['compile_s']:5.1f} + run {r['run_s']:5.1f}; {r['programs']} programs, {r['compiled']} compiled, "
+                f"{r['whole']} loaded whole")
     if command in COMMANDS:
         cold, warm = _digests(folder / "cold"), _digests(folder / "warm")
         runs["same_outputs"] = bool(cold) and cold == warm

@@ -29,9 +29,12 @@ _SPANS: dict[str, list[tuple[float, float]]] = {}
 _DEPTH: dict[str, int] = {}
 _LOCK = threading.Lock()
 
+PROGRAM_LOAD_EVENT = "/ignjax/programs/load_duration"
+"""The event of one program loaded whole from ignjax's program store (:mod:`ignjax.cache.programs`)."""
 COMPILE_EVENTS = ("/jax/core/compile/jaxpr_trace_duration", "/jax/core/compile/jaxpr_to_mlir_module_duration",
-                  "/jax/core/compile/backend_compile_duration")
-"""JAX's events for tracing, lowering and the backend compile (or cache load) of one program."""
+                  "/jax/core/compile/backend_compile_duration", PROGRAM_LOAD_EVENT)
+"""JAX's events for tracing, lowering and the backend compile (or cache load) of one program, and the program
+store's load of one program."""
 
 
 @contextmanager
@@ -70,13 +73,14 @@ def phase_spans(name: str) -> list[tuple[float, float]]:
 
 class CompileClock:
     """JAX's compile events from the moment it is started: their spans and
-    how many programs were obtained, compiled, or loaded from the persistent
-    compilation cache."""
+    how many programs were obtained, compiled, or loaded (from JAX's
+    persistent compilation cache or whole from ignjax's program store)."""
 
     def __init__(self):
         self.spans: list[tuple[float, float]] = []
         self.names: list[str] = []  # the programs obtained, in order (JAX's names, e.g. "jit(_run_sharded)")
         self.cache_hits = 0
+        self.whole = 0  # of the hits, programs loaded whole from the program store (no tracing or lowering)
         self._on = False
 
     def start(self) -> "CompileClock":
@@ -85,8 +89,11 @@ class CompileClock:
         def span(event, start, end, **kw):
             if self._on and event in COMPILE_EVENTS:
                 self.spans.append((start, end))
-                if event == COMPILE_EVENTS[2]:
+                if event in (COMPILE_EVENTS[2], PROGRAM_LOAD_EVENT):
                     self.names.append(str(kw.get("fun_name", "?")))
+                if event == PROGRAM_LOAD_EVENT:
+                    self.cache_hits += 1
+                    self.whole += 1
 
         def count(event, **_):
             if self._on and event == "/jax/compilation_cache/cache_hits":
@@ -124,4 +131,4 @@ def split(load_spans, compile_spans) -> dict:
     return {"load_s": load_s, "compile_s": compile_s}
 
 
-__all__ = ["COMPILE_EVENTS", "CompileClock", "in_phase", "phase", "phase_spans", "split", "union_seconds"]
+__all__ = ["COMPILE_EVENTS", "PROGRAM_LOAD_EVENT", "CompileClock", "in_phase", "phase", "phase_spans", "split", "union_seconds"]

@@ -127,7 +127,7 @@ class DoorTable:
     width: jax.Array
 
 
-@pytree_dataclass(static=("scene_ids", "categories", "config", "compiled", "navgrids"))
+@pytree_dataclass(static=("scene_ids", "categories", "config", "compiled", "navgrids"), untraced=("compiled", "navgrids"))
 @dataclass(frozen=True, eq=False)
 class SceneBank:
     """Many scenes as one pytree (see the module docstring).

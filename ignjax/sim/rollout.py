@@ -50,8 +50,10 @@ import jax.numpy as jnp
 import numpy as np
 from jax.sharding import Mesh, NamedSharding, PartitionSpec as P
 
+from ignjax.cache.programs import load_or_compile
 from ignjax.devices import available_cores
 from ignjax.errors import ConfigError
+from ignjax.sim import compact
 from ignjax.sim import env as E
 from ignjax.sim import types as T
 from ignjax.sim.compact import chunk_size, even_chunk, first_equal, masked_map
@@ -253,8 +255,10 @@ def _sharded(fn, world, specs, agent, params, keys, chunk, parts: int, copies: i
     is the one that runs."""
     n = specs.scene.shape[0]
     args, static, size = _sharded_args(fn, world, specs, agent, params, keys, chunk, parts, copies, out_axis)
-    ahead = _AHEAD.get(_program_key(args, static)) if _AHEAD else None
-    out = ahead(*args) if ahead is not None else _run_sharded(*args, **static)
+    key = _program_key(args, static)
+    if key not in _AHEAD:
+        compile_ahead([(args, static)])
+    out = _AHEAD[key](*args)
     if size == n:
         return out
     return cut_padding(out, n, out_axis)
@@ -293,9 +297,9 @@ _AHEAD: OrderedDict = OrderedDict()
 
 def _program_key(args, static: dict) -> tuple:
     """What makes :func:`_run_sharded` another program: its static arguments, the arguments' tree and each
-    leaf's shape, dtype and placement."""
+    leaf's shape, dtype and placement, and the tracing switch :data:`ignjax.sim.compact.ONE_PASS`."""
     leaves, tree = jax.tree.flatten(args)
-    return (tuple(static[k] for k in sorted(static)), tree,
+    return (compact.ONE_PASS, tuple(static[k] for k in sorted(static)), tree,
             tuple((np.shape(x), str(getattr(x, "dtype", type(x))), getattr(x, "sharding", None)) for x in leaves))
 
 
@@ -336,7 +340,7 @@ def compile_ahead(calls, workers: int | None = None) -> int:
 
     def compile_one(item):
         key, (args, static) = item
-        return key, _run_sharded.lower(*args, **static).compile()
+        return key, load_or_compile(_run_sharded, args, static, "rollout", context=(compact.ONE_PASS,))
 
     with ThreadPoolExecutor(max(1, min(len(todo), workers or available_cores()))) as pool:
         for key, program in pool.map(compile_one, todo.items()):

@@ -25,8 +25,8 @@ def _sweep_args(small_benchmark) -> list[str]:
 def test_main_job_twice_cold_then_warm_writes_the_same_bytes(small_benchmark, tmp_path):
     """Two fresh processes on an empty cache folder (the bench's
     ``time_to_result`` measurement): the first compiles and fills it, the
-    second loads every program from it (no new compilation entry) and its
-    scene arrays, and writes every output file byte for byte the same; the
+    second loads every program from it (no new compilation entry; the
+    rollout programs whole, without tracing) and its scene arrays, and writes every output file byte for byte the same; the
     block's split adds up."""
     from ignjax.bench.time_to_result import cold_and_warm
 
@@ -42,6 +42,8 @@ def test_main_job_twice_cold_then_warm_writes_the_same_bytes(small_benchmark, tm
     assert runs["same_outputs"] is True
     assert cold["compiled"] == cold["programs"] > 10 and cold["cache_hits"] == 0
     assert warm["compiled"] == 0 and warm["cache_hits"] == warm["programs"] > 10
+    stored = list((cache / "programs" / "rollout").glob("*.npz"))  # the rollout programs, kept whole
+    assert stored and cold["whole"] == 0 and warm["whole"] == len(stored), (len(stored), warm)
     for r in (cold, warm):
         assert r["load_s"] > 0 and r["compile_s"] > 0 and r["run_s"] > 0
         assert abs(r["load_s"] + r["compile_s"] + r["run_s"] - r["total_s"]) < 1e-6

@@ -1,0 +1,169 @@
+"""The program store (ignjax.cache.programs): programs kept whole on disk,
+keyed by what their trace is a function of, loaded back as the executable
+the compiler produced, and never stored when the key cannot vouch for them."""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import time
+import warnings
+
+import chex
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from ignjax.agents import get_agent
+from ignjax.cache import programs as PR
+from ignjax.cache.clock import CompileClock
+from ignjax.cache.store import ArrayStore, CacheWarning
+from ignjax.sim import compact
+from ignjax.sim import rollout as R
+from ignjax.sim.rollout import episode_keys, rollout_call
+
+
+@functools.partial(jax.jit, static_argnames=("n",))
+def _scaled(x, y, *, n):
+    return {"sum": x * n + y, "first": x[:1]}
+
+
+N = 3 + time.time_ns() % 1000  # a program no earlier run put in JAX's own cache (the suite's cache folder is kept)
+
+
+def _call(small_benchmark, n=12, agent="naive_asker"):
+    specs = jax.tree.map(lambda a: a[:n], small_benchmark["set"].specs)
+    agent = get_agent(agent)
+    return specs, agent, agent.default_params(), episode_keys(0, np.arange(n))
+
+
+@pytest.fixture
+def store(tmp_path, monkeypatch):
+    """A fresh program store, with this test module's functions trusted (their source is this file)."""
+    monkeypatch.setenv("IGNJAX_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setattr(PR, "TRUSTED_MODULES", PR.TRUSTED_MODULES + (__name__.split(".")[0],))
+    monkeypatch.setattr(PR, "_STORES", {})
+    return PR.program_store()
+
+
+def _args(n=4):
+    return (jnp.arange(n, dtype=jnp.float32), jnp.ones(n, jnp.float32))
+
+
+def test_a_stored_program_is_loaded_whole_and_gives_the_same_bytes(store):
+    args = _args()
+    clock = CompileClock().start()
+    first = PR.load_or_compile(_scaled, args, {"n": N}, "scaled")
+    assert clock.whole == 0 and list((store.root / "scaled").glob("*.npz")), "the compiled program was not stored"
+    again = PR.load_or_compile(_scaled, args, {"n": N}, "scaled")
+    clock.stop()
+    assert clock.whole == 1 and clock.names[-1] == "scaled"
+    chex.assert_trees_all_equal(jax.device_get(first(*args)), jax.device_get(again(*args)))
+    assert float(again(*args)["sum"][1]) == N + 1
+
+
+def test_the_key_follows_every_input_of_the_trace(store):
+    args = _args()
+    key = PR.program_key(_scaled, args, {"n": N})
+    assert key == PR.program_key(_scaled, _args(), {"n": N})  # equal arguments, equal key
+    assert key != PR.program_key(_scaled, args, {"n": N + 1})  # a static argument
+    assert key != PR.program_key(_scaled, _args(5), {"n": N})  # a shape
+    assert key != PR.program_key(_scaled, (args[0], args[1].astype(jnp.int32)), {"n": N})  # a dtype
+    assert key != PR.program_key(_scaled, (args[0], (args[1],)), {"n": N})  # the tree
+    assert key != PR.program_key(_scaled, args, {"n": N}, context=(True,))  # a tracing switch
+    with jax.numpy_rank_promotion("raise"):  # one of JAX's tracing settings
+        assert key != PR.program_key(_scaled, args, {"n": N})
+
+
+def test_code_it_cannot_vouch_for_is_compiled_and_never_stored(store, monkeypatch):
+    monkeypatch.setattr(PR, "TRUSTED_MODULES", tuple(m for m in PR.TRUSTED_MODULES if m != __name__.split(".")[0]))
+    assert PR.program_key(_scaled, _args(), {"n": N}) is None  # its source is not in the key
+    program = PR.load_or_compile(_scaled, _args(), {"n": N}, "scaled")
+    assert float(program(*_args())["sum"][1]) == N + 1 and not (store.root / "scaled").exists()
+
+    class Opaque:  # no faithful description
+        pass
+
+    with pytest.raises(PR.Unkeyable):
+        PR.stable(Opaque())
+    agent = dataclasses.replace(get_agent("random"), act=lambda *a: a)  # an agent written outside ignjax
+    with pytest.raises(PR.Unkeyable):
+        PR.stable(agent)
+
+
+def test_a_program_jax_cannot_serialise_runs_and_is_not_stored(store):
+    @functools.partial(jax.jit, static_argnames=("n",))
+    def with_callback(x, *, n):
+        return jax.pure_callback(lambda a: np.asarray(a) + n, jax.ShapeDtypeStruct(x.shape, x.dtype), x)
+
+    program = PR.load_or_compile(with_callback, (jnp.ones(3),), {"n": 2}, "callback")
+    assert np.array_equal(np.asarray(program(jnp.ones(3))), [3.0, 3.0, 3.0])
+    assert not list(store.root.glob("callback/*.npz"))
+
+
+def test_a_damaged_or_foreign_entry_is_compiled_again_with_a_warning(store):
+    args = _args()
+    PR.load_or_compile(_scaled, args, {"n": N}, "scaled")
+    key = PR.program_key(_scaled, args, {"n": N})
+    path = store.path("scaled", key)
+    path.write_bytes(path.read_bytes()[:-100])  # truncated: its checksum cannot match
+    with pytest.warns(CacheWarning, match="damaged|checksum"):
+        program = PR.load_or_compile(_scaled, args, {"n": N}, "scaled")
+    assert float(program(*args)["sum"][1]) == N + 1
+    entry = ArrayStore(store.root).get("scaled", key)  # rewritten whole by the compile
+    entry["executable"] = entry["executable"][::-1].copy()  # a valid entry whose executable will not load
+    ArrayStore(store.root).put("scaled", key, entry)
+    with pytest.warns(CacheWarning, match="does not load"):
+        program = PR.load_or_compile(_scaled, args, {"n": N}, "scaled")
+    assert float(program(*args)["sum"][1]) == N + 1
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the rewritten entry loads again, quietly
+        PR.load_or_compile(_scaled, args, {"n": N}, "scaled")
+
+
+def test_a_program_jax_loaded_from_its_own_cache_is_not_stored(store):
+    """XLA:CPU cannot serialise again an executable it loaded (the copy
+    misses kernels and fails in a fresh process), so a program JAX's own
+    persistent cache held is used, not stored."""
+    args = _args(6)
+    was = jax.config.jax_persistent_cache_min_compile_time_secs
+    jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
+    try:
+        _scaled.lower(*args, n=N + 2).compile()  # into JAX's cache
+        jax.clear_caches()  # else JAX hands back the executable it compiled (in memory), which is storable
+        program = PR.load_or_compile(_scaled, args, {"n": N + 2}, "scaled")  # out of it
+    finally:
+        jax.config.update("jax_persistent_cache_min_compile_time_secs", was)
+    assert float(program(*args)["sum"][1]) == N + 3
+    assert not (store.root / "scaled").exists()
+
+
+def test_the_store_is_off_with_the_compilation_cache(store):
+    was = jax.config.jax_enable_compilation_cache
+    jax.config.update("jax_enable_compilation_cache", False)  # what --no-compile-cache does
+    try:
+        assert PR.program_store() is None
+    finally:
+        jax.config.update("jax_enable_compilation_cache", was)
+    assert PR.program_store() is not None
+
+
+def test_a_rollout_program_key_ignores_the_host_side_scenes_only(small_benchmark, small_world):
+    """The scene bank's compiled MuJoCo scenes and navigation grids are
+    declared untraced: the rollout program lowers to the same text without
+    them, so the key leaves them out; every traced static field (scene ids,
+    the one-pass switch) changes it."""
+    specs, agent, params, keys = _call(small_benchmark)
+    args, static = rollout_call(small_world, specs, agent, params, keys, parts=1)
+    bare_bank = dataclasses.replace(small_world.bank, compiled=(), navgrids=())
+    bare = (dataclasses.replace(args[0], bank=bare_bank),) + tuple(args[1:])
+    key = PR.program_key(R._run_sharded, args, static)
+    assert key is not None and key == PR.program_key(R._run_sharded, bare, static)
+    renamed = dataclasses.replace(args[0], bank=dataclasses.replace(
+        small_world.bank, scene_ids=tuple(s + "_b" for s in small_world.bank.scene_ids)))
+    assert key != PR.program_key(R._run_sharded, (renamed,) + tuple(args[1:]), static)
+    assert key != PR.program_key(R._run_sharded, args, static, context=(not compact.ONE_PASS,))
+    assert key != PR.program_key(R._run_sharded, args, dict(static, agent=get_agent("eig")))
+    text = R._run_sharded.lower(*args, **static).as_text()
+    assert text == R._run_sharded.lower(*bare, **static).as_text()
