@@ -19,6 +19,7 @@ modules that compute them.
 from __future__ import annotations
 
 import dataclasses
+import weakref
 
 import numpy as np
 
@@ -35,11 +36,19 @@ _ARRAYS = tuple(f.name for f in dataclasses.fields(NavGrid)
                 if f.name not in _SCALARS + ("scene_id", "config", "shape", "room_ids"))
 
 
+_SCENE_KEYS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
 def scene_key(compiled) -> str:
     """Digest of a compiled scene's source: its lossless JSON without its id
     and metadata (where it was read from; a copy under another name or path
-    has the same arrays) and the compile options."""
-    return digest(scene_to_json(dataclasses.replace(compiled.scene, id="", meta=SceneMeta())), compiled.options)
+    has the same arrays) and the compile options. Kept per compiled scene
+    (its grid and its fields both ask; a scene's JSON takes milliseconds)."""
+    key = _SCENE_KEYS.get(compiled)
+    if key is None:
+        key = _SCENE_KEYS[compiled] = digest(
+            scene_to_json(dataclasses.replace(compiled.scene, id="", meta=SceneMeta())), compiled.options)
+    return key
 
 
 def cached_navgrid(compiled, config: GridConfig = GridConfig()) -> NavGrid:
