@@ -6,17 +6,21 @@ the update counter and the key; :class:`ignjax.rl.ppo.Rows`: every
 environment's episode, observation, mask, memory and key), as numpy arrays
 flattened in pytree order, so ``--resume`` continues with the same bytes as
 a run that never stopped. Beside it, ``<update>/policy.msgpack`` holds the
-weights alone (flax's serialisation: the same seed gives the same bytes)
-and ``<update>.json`` the record a reader checks before any episode
-(:mod:`ignjax.agents.learned.record`, re-exported here): the package
-version, the observation layout (slice names and sizes), the action names,
-the network's settings and the run's fingerprint. A checkpoint counts once its record exists (it is written
+weights alone (flax's serialisation: the same seed gives the same bytes),
+``<update>/policy.npz`` the same weights as plain named arrays
+(:mod:`ignjax.agents.learned.weights`: what the ``learned`` agent reads,
+without flax) and ``<update>.json`` the record a reader checks before any
+episode (:mod:`ignjax.agents.learned.record`, re-exported here): the
+package version, the observation layout (slice names and sizes), the action
+names, the network's settings, the run's fingerprint and the SHA-256 of
+``policy.npz``. A checkpoint counts once its record exists (it is written
 after orbax has committed the folder), so a run killed mid-save resumes
 from the one before.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import shutil
 from pathlib import Path
@@ -28,6 +32,7 @@ import orbax.checkpoint as ocp
 from ignjax.agents.learned.record import (
     CHECKED, FORMAT, check_record, folder, latest, read_record, record, record_path,
 )
+from ignjax.agents.learned.weights import WEIGHTS_FILE, from_flax, npz_bytes
 from ignjax.errors import InputError
 from ignjax.errors.extras import optional_module
 from ignjax.fileio import atomic_write
@@ -46,6 +51,9 @@ def save(run: Path, state, meta: dict) -> Path:
         ck.save(path.resolve(), {f"{i:05d}": x for i, x in enumerate(leaves)})
     params = jax.device_get(state[0].params)
     atomic_write(path / "policy.msgpack", serialization.to_bytes(params))
+    weights = npz_bytes(from_flax(params))
+    atomic_write(path / WEIGHTS_FILE, weights)
+    meta = {**meta, "weights_sha256": hashlib.sha256(weights).hexdigest()}
     atomic_write(path.with_suffix(".json"), json.dumps(meta, indent=2, sort_keys=True) + "\n")
     return path
 
