@@ -161,8 +161,9 @@ def default_params() -> LearnedParams:
 
 
 LEARNED = Agent("learned", learned_init, learned_act, default_params, asks=True,
-                description="a policy trained with python -m ignjax.rl.train (agents.learned.checkpoint; default: "
-                            "the shipped one), greedy, reading the costs it is charged", source=SOURCE)
+                description="a policy trained by python -m ignjax.rl.train (agents.learned.checkpoint; default: a "
+                            "small shipped one), reading the costs it is charged; greedy unless "
+                            "agents.learned.greedy = false", source=SOURCE)
 
 
 __all__ = ["CheckpointSource", "LEARNED", "LearnedParams", "LearnedState", "SETTINGS", "SOURCE", "default_params",
