@@ -32,7 +32,7 @@ from typing import Any, ClassVar
 from ignjax.agents import registry
 from ignjax.agents.llm.catalog import LLM_AGENTS, get_llm_agent
 from ignjax.agents.llm.config import LLMConfig
-from ignjax.agents.params import check_param_value, make_params, param_docs, param_values
+from ignjax.agents.params import check_param_value, make_params, param_docs, param_record, param_values
 from ignjax.arrays import field_docs, parse_assignment
 from ignjax.episodes.difficulty import validate_alpha, validate_thresholds
 from ignjax.errors import ConfigError
@@ -304,16 +304,24 @@ class AgentsConfig:
 
     __hash__ = None
 
-    def make(self, name: str, costs=None):
+    def make(self, name: str, costs=None, sim: SimConfig | None = None):
         """The parameter pytree of agent ``name`` with these values, planning
-        with ``costs`` (the charged costs) if it is cost-aware."""
-        return make_params(registry()[name], self.params[name], costs)
+        with ``costs`` (the charged costs) if it is cost-aware; ``sim``: the
+        simulator's configuration (the learned agent's observation is laid
+        out and checked by it)."""
+        return make_params(registry()[name], self.params[name], costs, sim)
 
-    def used(self, names) -> dict[str, dict[str, Any]]:
-        """``name -> parameters`` of the agents ``names`` (for run.json and report headers); an MLLM agent's
-        options."""
-        return {n: dict(self.params[n]) if n in self.params else {k: v for k, v in vars(get_llm_agent(n)).items() if k not in ('name', 'description')}
-                for n in dict.fromkeys(names)}
+    def used(self, names, sim: SimConfig | None = None) -> dict[str, dict[str, Any]]:
+        """``name -> parameters`` of the agents ``names`` (for run.json and report headers): their values, for an
+        agent loaded from files what was loaded (the learned agent's checkpoint path and weights' digest, checked
+        under ``sim``); an MLLM agent's options."""
+        def one(n):
+            if n not in self.params:
+                return {k: v for k, v in vars(get_llm_agent(n)).items() if k not in ('name', 'description')}
+            agent = registry()[n]
+            return param_record(agent, self.params[n], sim) if agent.source is not None else dict(self.params[n])
+
+        return {n: one(n) for n in dict.fromkeys(names)}
 
 
 @dataclass(frozen=True)
@@ -517,12 +525,35 @@ FINGERPRINT_IGNORES = {"llm": ("endpoints", "concurrency", "timeout_s", "cache_d
 server address, concurrency or render process count is the same run."""
 
 
+def rolled_out(cfg: SweepConfig, studies) -> list[str]:
+    """The agents ``studies`` roll out: ``eval.agents`` (the eval, difficulty and analysis studies),
+    ``analysis.agent`` and, for the cost study, ``costs.agent``."""
+    if not any(s in studies for s in ("eval", "costs", "difficulty", "analysis")):
+        return []
+    extra = ([cfg.analysis.agent] if "analysis" in studies else []) + ([cfg.costs.agent] if "costs" in studies else [])
+    return list(dict.fromkeys(list(cfg.eval.agents) + extra))
+
+
+def loaded_agents(cfg: SweepConfig, studies) -> dict[str, dict]:
+    """``name -> what was loaded`` for the agents ``studies`` roll out whose parameters are files (the learned
+    agent: its checkpoint's path and weights' SHA-256), each read and checked under ``cfg.sim``.
+
+    Raises:
+        InputError: a checkpoint that is missing or does not fit this package and simulator configuration.
+    """
+    names = [n for n in rolled_out(cfg, studies) if n in registry() and registry()[n].source is not None]
+    return cfg.agents.used(names, cfg.sim)
+
+
 def fingerprint(cfg: SweepConfig, studies: list[str]) -> str:
-    """Hash of what determines a run's outputs (configuration + studies; not :data:`FINGERPRINT_IGNORES`)."""
+    """Hash of what determines a run's outputs (configuration + studies; not :data:`FINGERPRINT_IGNORES`;
+    with the digests of the weights the rolled-out agents load, :func:`loaded_agents`, so a policy retrained
+    into the same folder is another run)."""
     d = cfg.to_dict()
     for section, keys in FINGERPRINT_IGNORES.items():
         d[section] = {k: v for k, v in d[section].items() if k not in keys}
-    return digest({"config": d, "studies": list(studies)})
+    loaded = {n: r["weights_sha256"] for n, r in loaded_agents(cfg, studies).items()}
+    return digest({"config": d, "studies": list(studies), **({"weights": loaded} if loaded else {})})
 
 
 # ---------------------------------------------------------------------------
@@ -565,5 +596,5 @@ def default_toml() -> str:
 __all__ = [
     "AnalysisConfig", "BenchmarkConfig", "CostsConfig", "DeriveCostsConfig", "DifficultyConfig", "EvalConfig", "QUICK",
     "RunConfig", "SECTIONS", "SweepConfig", "default_toml", "digest", "field_docs", "fingerprint", "load_toml",
-    "parse_set", "resolve", "to_toml",
+    "loaded_agents", "parse_set", "resolve", "rolled_out", "to_toml",
 ]

@@ -9,8 +9,11 @@ Modules, lowest first:
 * :mod:`~ignjax.agents.motion`: MOVE toward a bearing, direction to explore;
 * :mod:`~ignjax.agents.belief`: belief over target hypotheses, answer
   models, EIG of each question type (Eq. 1);
-* :mod:`~ignjax.agents.policies`: the five built-in agents (``random``,
-  ``shortest_path``, ``explorer``, ``naive_asker``, ``eig``);
+* :mod:`~ignjax.agents.policies`: the scripted built-in agents (``random``,
+  ``shortest_path``, ``explorer``, ``described``, ``naive_asker``, ``eig``);
+* :mod:`~ignjax.agents.learned`: the ``learned`` agent, a policy trained by
+  ``python -m ignjax.rl.train`` (its observation vector, actions, weights and
+  checkpoints, shared with :mod:`ignjax.rl`);
 * :mod:`~ignjax.agents.catalog`: :data:`AGENTS`, the immutable registry by
   name, and :func:`get_agent`.
 

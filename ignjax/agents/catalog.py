@@ -7,10 +7,12 @@ from types import MappingProxyType
 from typing import Mapping
 
 from ignjax.agents.agent import Agent
+from ignjax.agents.learned import LEARNED
 from ignjax.agents.policies import DESCRIBED, EIG, EXPLORER, NAIVE_ASKER, RANDOM, SHORTEST_PATH
 from ignjax.errors import ConfigError
 
-AGENTS: Mapping[str, Agent] = MappingProxyType({a.name: a for a in (RANDOM, SHORTEST_PATH, EXPLORER, DESCRIBED, NAIVE_ASKER, EIG)})
+AGENTS: Mapping[str, Agent] = MappingProxyType({a.name: a for a in (RANDOM, SHORTEST_PATH, EXPLORER, DESCRIBED, NAIVE_ASKER, EIG,
+                                                                   LEARNED)})
 """Built-in agents by name (immutable)."""
 
 

@@ -7,6 +7,15 @@ values (floats, bools, ints, tuples for arrays), the form the sweep's
 ``run.json`` use; :func:`make_params` builds the pytree back from such
 values, checked against the defaults' shapes.
 
+An agent whose parameters are loaded from files (an
+:class:`~ignjax.agents.agent.ParamSource`, the ``learned`` agent's
+checkpoint) lists its source's settings instead (``checkpoint``,
+``greedy``): :func:`make_params` has the source build the pytree (the
+weights as arrays) and :func:`param_record` gives what ``run.json`` keeps
+(the checkpoint's path and its weights' digest, never the numbers). Both
+take the simulator's configuration, which such a source may check the
+files against (the learned policy's observation layout).
+
 Costs are not an agent setting: a cost-aware agent plans with the costs it
 is charged. Its ``costs`` field is always set from the evaluation's charged
 costs (``eval.costs`` of the sweep, ``--costs`` of ``python -m
@@ -25,6 +34,7 @@ import numpy as np
 from ignjax.agents.agent import Agent
 from ignjax.arrays import field_docs
 from ignjax.errors import ConfigError
+from ignjax.sim.types import SimConfig
 
 PLANNED_COSTS_FIELD = "costs"
 """The params field a cost-aware agent plans with; set from the charged costs."""
@@ -53,12 +63,17 @@ def param_values_of(params, include_costs: bool = True) -> dict[str, Any]:
 
 def param_values(agent: Agent, include_costs: bool = False) -> dict[str, Any]:
     """``field -> Python value`` of the agent's default parameters (no
-    ``costs`` unless asked: those are the charged costs)."""
+    ``costs`` unless asked: those are the charged costs); for an agent with
+    a :class:`~ignjax.agents.agent.ParamSource`, its settings' defaults."""
+    if agent.source is not None:
+        return dict(agent.source.settings())
     return param_values_of(agent.default_params(), include_costs)
 
 
 def param_docs(agent: Agent) -> dict[str, str]:
-    """``field -> description`` from the params class' docstring."""
+    """``field -> description`` from the params class' docstring (a source's own descriptions)."""
+    if agent.source is not None:
+        return dict(agent.source.docs())
     return field_docs(type(agent.default_params()))
 
 
@@ -79,6 +94,10 @@ def check_param_value(agent: Agent, key: str, value: Any, where: str | None = No
     default = defaults[key]
 
     def scalar(v, d):
+        if isinstance(d, str):
+            if not isinstance(v, str):
+                raise ConfigError(where, name, f"expected a string (quote it: \"{v}\"), got {v!r}")
+            return v
         if isinstance(d, bool):
             if not isinstance(v, bool):
                 raise ConfigError(where, name, f"expected true or false, got {v!r}")
@@ -98,11 +117,19 @@ def check_param_value(agent: Agent, key: str, value: Any, where: str | None = No
     return scalar(value, default)
 
 
-def make_params(agent: Agent, values: Mapping[str, Any] | None = None, costs=None):
+def make_params(agent: Agent, values: Mapping[str, Any] | None = None, costs=None, config: SimConfig | None = None):
     """The agent's parameter pytree: defaults, with ``values`` (field -> Python
     value, checked by :func:`check_param_value`) and, for a cost-aware agent,
-    the charged ``costs`` as the costs it plans with."""
-    params = agent.default_params()
+    the charged ``costs`` as the costs it plans with. An agent with a
+    :class:`~ignjax.agents.agent.ParamSource` has it build the pytree under
+    the simulator's ``config`` (default ``SimConfig()``; it may raise
+    :class:`~ignjax.errors.InputError` on the files ``values`` name)."""
+    if agent.source is not None:
+        checked = {k: check_param_value(agent, k, v) for k, v in (values or {}).items()}
+        params = agent.source.build({**agent.source.settings(), **checked}, config or SimConfig())
+        values = None
+    else:
+        params = agent.default_params()
     if not dataclasses.is_dataclass(params):
         if values:
             raise ConfigError(None, f"agents.{agent.name}", "this agent has no parameters")
@@ -118,11 +145,33 @@ def make_params(agent: Agent, values: Mapping[str, Any] | None = None, costs=Non
     return dataclasses.replace(params, **changes)
 
 
+def param_record(agent: Agent, values: Mapping[str, Any] | None = None, config: SimConfig | None = None,
+                 params=None) -> dict[str, Any]:
+    """What ``run.json`` records of an agent's parameters: every field's value
+    (of ``params``, default those :func:`make_params` builds from ``values``);
+    for an agent with a :class:`~ignjax.agents.agent.ParamSource`, the
+    source's record of what ``values`` name (the checkpoint's path and its
+    weights' SHA-256, checked under ``config``), with the ``costs`` it plans
+    with when ``params`` are given.
+
+    Raises:
+        InputError: a source's file is missing or does not fit ``config``.
+    """
+    if agent.source is None:
+        params = make_params(agent, values, config=config) if params is None else params
+        return param_values_of(params)
+    checked = {k: check_param_value(agent, k, v) for k, v in (values or {}).items()}
+    out = agent.source.describe({**agent.source.settings(), **checked}, config or SimConfig())
+    if params is not None and hasattr(params, PLANNED_COSTS_FIELD):
+        out[PLANNED_COSTS_FIELD] = _python(getattr(params, PLANNED_COSTS_FIELD))
+    return out
+
+
 def plans_with_costs(agent: Agent) -> bool:
     """The agent is cost-aware: its parameters hold the costs it plans with."""
     params = agent.default_params()
     return dataclasses.is_dataclass(params) and hasattr(params, PLANNED_COSTS_FIELD)
 
 
-__all__ = ["PLANNED_COSTS_FIELD", "check_param_value", "make_params", "param_docs", "param_values", "param_values_of",
-           "plans_with_costs"]
+__all__ = ["PLANNED_COSTS_FIELD", "check_param_value", "make_params", "param_docs", "param_record", "param_values",
+           "param_values_of", "plans_with_costs"]

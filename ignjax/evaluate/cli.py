@@ -38,7 +38,12 @@ normally are kept (``OUT/llm/<agent>.progress.jsonl``,
 ``--set sim.<key>=<value>`` sets any :class:`~ignjax.sim.types.SimConfig`
 field and ``--set agents.<name>.<key>=<value>`` any agent parameter (the keys
 of the sweep's ``[sim]`` and ``[agents.<name>]`` tables). A cost-aware agent
-plans with the costs it is charged (``--costs``).
+plans with the costs it is charged (``--costs``). ``--agent learned`` plays a
+policy trained by ``python -m ignjax.rl.train``: ``--set
+agents.learned.checkpoint=PATH`` (a checkpoint folder, a run folder or an
+exported policy; default the shipped one), read and checked with the other
+settings, before any episode; ``run.json`` records its path and the SHA-256
+of its weights.
 The metrics can be recomputed from either outcome file alone
 (``ignjax.evaluate.outcomes.metric_rows(read_outcomes(path))``).
 
@@ -271,6 +276,7 @@ def check_settings(args, popts: PR.ProcessOptions = PR.ProcessOptions()) -> dict
     """
     from ignjax.agents import get_agent
     from ignjax.agents.llm.catalog import LLM_AGENTS, get_llm_agent
+    from ignjax.agents.params import param_record
 
     agents = [get_llm_agent(a) if a in LLM_AGENTS else get_agent(a) for a in args.agent]
     sim, agent_values, sections = parse_settings(args.set, [a.name for a in agents], ("llm", "views"))
@@ -297,6 +303,9 @@ def check_settings(args, popts: PR.ProcessOptions = PR.ProcessOptions()) -> dict
         args.episodes = str(shipped_episodes())
     elif not Path(args.episodes).is_file():
         raise ConfigError(None, "--episodes", f"{args.episodes}: file not found")
+    for a in agents:  # an agent whose parameters are files (the learned agent's checkpoint): checked before any episode
+        if getattr(a, "source", None) is not None:
+            param_record(a, agent_values.get(a.name), sim)
     return {"agents": agents, "sim": sim, "agent_values": agent_values, "out_dir": out_dir, "llm_agents": llm_agents,
             "llm": llm, "views": views, "thresholds": thresholds, "costs": costs}
 
@@ -330,7 +339,7 @@ def run(args, settings: dict | None = None, popts: PR.ProcessOptions = PR.Proces
     # imported on use, so that --help and the other commands answer at once
     from tqdm.auto import tqdm
 
-    from ignjax.agents.params import make_params, param_values_of
+    from ignjax.agents.params import make_params, param_record
     from ignjax.devices.parts import PartStore
     from ignjax.episodes.dataset import open_benchmark
     from ignjax.evaluate.runner import bucket_batches, plan_run
@@ -350,10 +359,12 @@ def run(args, settings: dict | None = None, popts: PR.ProcessOptions = PR.Proces
     except ConfigError as e:
         raise ConfigError(None, "--parts", e.reason) from None
     quiet = args.quiet or not group.main
-    # a cost-aware agent plans with the costs it is charged
-    params = {a.name: make_params(a, st["agent_values"].get(a.name), costs=costs) for a in agents
+    # a cost-aware agent plans with the costs it is charged; run.json records every parameter's value, and of
+    # weights loaded from a checkpoint its path and digest
+    params = {a.name: make_params(a, st["agent_values"].get(a.name), costs=costs, config=sim) for a in agents
               if a.name not in llm_names}
-    used: dict[str, dict] = {name: param_values_of(p) for name, p in params.items()}
+    used: dict[str, dict] = {a.name: param_record(a, st["agent_values"].get(a.name), sim, params[a.name])
+                             for a in agents if a.name in params}
     store = PartStore(out_dir / "parts")
     if group.main:
         kept = store.prepare(_fingerprint(args, sim, used), args.resume)

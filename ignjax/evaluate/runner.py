@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 from ignjax.cache.clock import in_phase
 from ignjax.agents import Agent, get_agent
+from ignjax.agents.params import make_params
 from ignjax.episodes.dataset import BenchmarkScenes, EpisodeSet
 from ignjax.sim.rollout import compile_ahead, episode_keys, pad_batch, rollout, rollout_call
 from ignjax.sim.env import check_specs
@@ -85,8 +86,8 @@ def agent_batches(es: EpisodeSet, agent: Agent | str, *, params=None, batch: int
     Trajectory)`` (numpy, the chunk's real episodes only) for the chunks
     ``select`` names (default all; :func:`episode_batches`)."""
     agent = get_agent(agent) if isinstance(agent, str) else agent
-    params = agent.default_params() if params is None else params
     world = world or make_world(es, config)
+    params = make_params(agent, config=world.config) if params is None else params  # the defaults
     if world.config.n_views != N_VIEWS:
         raise ConfigError(None, "sim.n_views", f"the built-in JAX agents plan with {N_VIEWS} views; got "
                           f"{world.config.n_views} (other view counts are for image-based agents)")

@@ -15,6 +15,10 @@ Two linear heads read the core's output: the logits over the 21 actions
 the value. :meth:`Policy.__call__` runs one step for a batch;
 :meth:`Policy.sequence` scans it over time (the update re-runs the rollout's
 sequences from their stored first state).
+
+:func:`ignjax.agents.learned.weights.forward` is the same step in plain
+``jax.numpy`` on the weights exported as named arrays (``policy.npz``), which
+the ``learned`` agent plays without flax; a test keeps the two equal.
 """
 
 from __future__ import annotations
@@ -23,12 +27,10 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ignjax.agents.learned.weights import MASKED_LOGIT
 from ignjax.errors.extras import optional_module
 
 nn = optional_module("flax.linen", "rl")
-
-MASKED_LOGIT = -1e9
-"""The logit a masked action gets."""
 
 
 def _dense(features: int, scale: float):

@@ -1,4 +1,6 @@
-"""The run folder of a sweep: which run it holds (``run.json``) and the
+"""The run folder of a sweep: which run it holds (``run.json``: the
+fingerprint, the configuration, and ``loaded_agents``, the checkpoint path
+and weights' SHA-256 of each agent whose parameters are files) and the
 rollout stages already finished (``checkpoints/``, orbax), so that
 ``--resume`` continues exactly where a killed run stopped."""
 
@@ -11,7 +13,7 @@ from pathlib import Path
 import orbax.checkpoint as ocp
 
 from ignjax import __version__
-from ignjax.config import SweepConfig, fingerprint
+from ignjax.config import SweepConfig, fingerprint, loaded_agents
 from ignjax.errors import InputError
 from ignjax.fileio import atomic_write, remove_leftover_temporaries
 
@@ -37,7 +39,8 @@ def prepare_folder(out: Path, cfg: SweepConfig, studies: list[str], resume: bool
             remove_leftover_temporaries(out)  # a file being written when the killed run stopped
     out.mkdir(parents=True, exist_ok=True)
     if not meta.is_file():
-        record = {"fingerprint": fp, "ignjax_version": __version__, "studies": studies, "config": cfg.to_dict()}
+        record = {"fingerprint": fp, "ignjax_version": __version__, "studies": studies, "config": cfg.to_dict(),
+                  "loaded_agents": loaded_agents(cfg, studies)}
         atomic_write(meta, json.dumps(record, indent=2, sort_keys=True) + "\n")
 
 

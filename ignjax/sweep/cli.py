@@ -82,7 +82,7 @@ def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     # Deferred so that `--help` and option errors answer without loading jax, scipy, orbax, the simulator and
     # the studies (measured on the 2-core dev machine: `--help` 0.15 s; 4.6 s with these two at the top).
-    from ignjax.config import resolve
+    from ignjax.config import loaded_agents, resolve
 
     try:
         apply_cache_arguments(args)  # before anything compiles, the configuration's checks included
@@ -92,6 +92,7 @@ def main(argv=None) -> int:
         # once, before it starts any process
         group = PR.start(popts) if not popts.launch else PR.SINGLE
         cfg = resolve(args.config, args.sets, args.quick)
+        loaded_agents(cfg, studies)  # a learned agent's checkpoint is read and checked before any work
         out = Path(args.out) if args.out else Path(cfg.run.out) / cfg.run.name
         if popts.launch or popts.distributed:
             check_processes(cfg, studies)

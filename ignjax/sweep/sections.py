@@ -542,7 +542,7 @@ def write_outputs(results: dict, out: Path) -> None:
                   f"charged (and planned with by cost-aware agents): {costs_by_type(cfg.eval.costs)}; "
                   f"{M.success_rule(cfg.eval.require_stop)}.", ""]
         agents = list(dict.fromkeys(list(cfg.eval.agents) + ([cfg.analysis.agent] if "analysis" in studies else [])))
-        parts += settings_lines(cfg.to_dict()["sim"], cfg.agents.used(agents))
+        parts += settings_lines(cfg.to_dict()["sim"], cfg.agents.used(agents, cfg.sim))
         parts += [mllm_settings_line(cfg)] if any(a in LLM_AGENTS for a in agents) else []
         parts += [""] + definitions_lines(cfg)
     for name, section in SECTIONS.items():

@@ -167,7 +167,7 @@ def _costs_setup(cfg: SweepConfig):
 def _costs_params(cfg: SweepConfig, agent, costs):
     """The cost-aware agent's parameters, one row per charged cost vector (each setting plans with the vector it
     is charged)."""
-    base = cfg.agents.make(agent.name)
+    base = cfg.agents.make(agent.name, sim=cfg.sim)
     params = jax.tree.map(lambda x: jnp.broadcast_to(x, (len(costs),) + jnp.shape(x)), base)
     return dataclasses.replace(params, costs=jnp.asarray(costs, jnp.float32))
 
@@ -184,7 +184,7 @@ def _stage_programs(es, world, work: dict, plans: dict, cfg: SweepConfig, c_agen
             calls.append(batch_program(es, world, c_agent, c_params, batch, seed, chunk, parts, sweep=True))
         else:
             agent = stage.split("/", 1)[1]
-            calls.append(batch_program(es, world, agent, cfg.agents.make(agent, costs=cfg.eval.costs), batch, seed,
+            calls.append(batch_program(es, world, agent, cfg.agents.make(agent, cfg.eval.costs, cfg.sim), batch, seed,
                                        chunk, parts))
     return calls
 
@@ -224,7 +224,7 @@ def rollout_stage_parts(bs: BenchmarkScenes, plans: dict, todo: dict, cfg: Sweep
                 continue
             agent = stage.split("/", 1)[1]
             # a cost-aware agent plans with the costs it is charged (eval.costs)
-            params = cfg.agents.make(agent, costs=cfg.eval.costs)
+            params = cfg.agents.make(agent, cfg.eval.costs, cfg.sim)
             for c, out, traj in agent_batches(es, agent, params=params, batch=plans[stage].batch, seed=seed,
                                               world=world, parts=parts, select=select):
                 store.write(stage, index[c], {"out": _to_tree(out), "traj": _to_tree(traj)})

@@ -125,3 +125,30 @@ def test_checkpoint_of_another_layout_is_refused(runs, capsys, key, value, says)
     with pytest.raises(Exception, match=says):
         C.check_record(record, C.record(TrainConfig().sim, {"core": "gru", "hidden": 64, "layers": 2}, "", 0), meta)
     assert jax.device_count() >= 1
+
+
+def test_checkpoints_hold_the_weights_as_plain_arrays(runs, tmp_path, capsys):
+    """Every checkpoint's ``policy.npz`` is its ``policy.msgpack`` as named arrays, with its digest in the record;
+    a checkpoint written without one (an older run) gets the same bytes from ``python -m ignjax.rl.export``,
+    and ``--out`` makes an exported policy folder the learned agent loads."""
+    from ignjax.agents.learned.source import load
+    from ignjax.agents.learned.weights import from_flax, npz_bytes, read_npz
+    from ignjax.fileio import file_sha256
+    from ignjax.rl.export import main as export
+
+    last = runs["out"] / "a" / "checkpoints" / f"{UPDATES:08d}"
+    npz = last / "policy.npz"
+    tree = C.serialization.msgpack_restore((last / "policy.msgpack").read_bytes())
+    assert npz.read_bytes() == npz_bytes(from_flax(tree))
+    assert C.read_record(last)["weights_sha256"] == file_sha256(npz)
+    old = tmp_path / "run"
+    shutil.copytree(runs["out"] / "a", old)
+    (old / "checkpoints" / f"{UPDATES:08d}" / "policy.npz").unlink()
+    assert export([str(old), "--out", str(tmp_path / "exported")]) == 0  # the run folder: its newest checkpoint
+    assert (old / "checkpoints" / f"{UPDATES:08d}" / "policy.npz").read_bytes() == npz.read_bytes()
+    loaded = load(tmp_path / "exported")
+    assert loaded.sha256 == file_sha256(npz) and loaded.record["update"] == UPDATES
+    assert loaded.record["training"]["fingerprint"] == json.loads((old / "run.json").read_text())["fingerprint"]
+    assert set(read_npz(npz)) == set(loaded.weights)
+    capsys.readouterr()
+    assert export([str(tmp_path)]) == 2 and "not a policy" in capsys.readouterr().err
