@@ -73,11 +73,11 @@ def test_shipped_policy_is_recorded_checked_and_small():
 
 
 def test_settings_and_run_record_name_the_checkpoint_not_the_weights(tmp_path):
-    assert param_values(LEARNED) == {"checkpoint": "", "greedy": True}
+    assert param_values(LEARNED) == {"checkpoint": "", "greedy": False}
     folder = export(tmp_path / "p")
-    params = make_params(LEARNED, {"checkpoint": str(folder), "greedy": False},
+    params = make_params(LEARNED, {"checkpoint": str(folder), "greedy": True},
                          costs=[float(c) for c in DOUBLE.split(",")])
-    assert isinstance(params, LearnedParams) and not bool(params.greedy)
+    assert isinstance(params, LearnedParams) and bool(params.greedy)
     np.testing.assert_allclose(params.costs, [float(c) for c in DOUBLE.split(",")])
     assert any(leaf.size == 64 * 64 for leaf in jax.tree.leaves(params))  # the weights are the pytree's leaves
     rec = param_record(LEARNED, {"checkpoint": str(folder)}, SimConfig(), params)
@@ -116,14 +116,14 @@ def test_default_parameters_stay_concrete_when_first_built_under_a_trace():
 @pytest.fixture(scope="module")
 def evaluated(small_benchmark, tmp_path_factory):
     """``--agent learned`` with the shipped policy, then with a checkpoint named by --set (the same network
-    shape, so the same compiled program), greedy off and twice the locked costs."""
+    shape, so the same compiled program), greedy on and twice the locked costs."""
     out = tmp_path_factory.mktemp("eval_learned")
     ckpt = export(out / "exported", random_weights(seed=1))
     argv = ["--episodes", str(small_benchmark["path"]), "--agent", "learned", "--limit", "8", "--batch", "8",
             "--quiet"]
     assert main(argv + ["--out", str(out / "shipped")]) == 0
     assert main(argv + ["--out", str(out / "set"), "--costs", DOUBLE, "--set", f"agents.learned.checkpoint={ckpt}",
-                        "--set", "agents.learned.greedy=false"]) == 0
+                        "--set", "agents.learned.greedy=true"]) == 0
     return {"out": out, "checkpoint": ckpt}
 
 
@@ -134,12 +134,12 @@ def test_evaluate_runs_the_learned_agent(evaluated):
         rows = read_outcomes(evaluated["out"] / name / "outcomes.csv")
         assert len(rows) == 8 and {r["agent"] for r in rows} == {"learned"}
     shipped = json.loads((evaluated["out"] / "shipped" / "run.json").read_text())["agents"]["learned"]
-    assert shipped["checkpoint"] == str(SHIPPED) and shipped["greedy"] is True
+    assert shipped["checkpoint"] == str(SHIPPED) and shipped["greedy"] is False
     assert shipped["weights_sha256"] == file_sha256(SHIPPED / WEIGHTS_FILE)
     assert shipped["costs"] == pytest.approx(LOCKED_COSTS)
     text = (evaluated["out"] / "set" / "run.json").read_text()
     used = json.loads(text)["agents"]["learned"]
-    assert used["checkpoint"] == str(evaluated["checkpoint"]) and used["greedy"] is False
+    assert used["checkpoint"] == str(evaluated["checkpoint"]) and used["greedy"] is True
     assert used["weights_sha256"] == file_sha256(evaluated["checkpoint"] / WEIGHTS_FILE)
     assert used["costs"] == pytest.approx([float(c) for c in DOUBLE.split(",")])  # planned = charged
     assert set(used) == {"checkpoint", "weights_sha256", "network", "update", "training_fingerprint", "greedy",

@@ -28,7 +28,7 @@ def tiny(episodes, out, name="a") -> list[str]:
     costs are the locked ones x 8, so a random policy's ~2 questions per episode cost most of its return."""
     sets = {"houses.episodes": f'"{episodes}"', "run.out": f'"{out}"', "run.name": f'"{name}"', "ppo.num_envs": 16,
             "ppo.steps": 20, "ppo.total_steps": 16 * 20 * UPDATES, "ppo.updates_per_call": 5, "ppo.minibatches": 2,
-            "ppo.checkpoint_every": 5, "ppo.lr": 0.003, "env.tau": 100.0, "env.sample_costs": "false",
+            "ppo.checkpoint_every": 5, "ppo.lr": 0.003, "ppo.epochs": 2, "env.shaping": 0.0, "env.tau": 100.0, "env.sample_costs": "false",
             "env.costs": "[1.5, 1.3, 1.9, 0.8]"}
     return ["--no-progress"] + [a for k, v in sets.items() for a in ("--set", f"{k}={v}")]
 

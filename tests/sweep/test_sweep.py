@@ -302,11 +302,13 @@ def test_default_toml_is_generated_from_the_dataclasses():
     assert SweepConfig.from_dict(SweepConfig().to_dict()) == SweepConfig()
 
 
-@pytest.mark.parametrize("name", ["default.toml", "cost_sensitivity_large.toml"])
+@pytest.mark.parametrize("name", ["default.toml", "cost_sensitivity_large.toml", "learned_study.toml"])
 def test_shipped_configs_resolve(name):
     cfg = resolve(REPO / "sweeps" / name)
     if name == "cost_sensitivity_large.toml":
         assert cfg.costs.samples == 1_000_000 and cfg.run.name == "costs_large"
+    if name == "learned_study.toml":
+        assert cfg.eval.agents[0] == "learned" and cfg.costs.agent == "learned"
 
 
 def test_config_is_frozen_typed_and_checked_from_python():

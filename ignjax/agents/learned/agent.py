@@ -13,13 +13,13 @@ both on the same episodes and compares their actions). Its state is the
 GRU's memory and whether the next step is the episode's first (the memory is
 zeroed then, as in training).
 
-**Greedy by default.** ``greedy = true`` takes the most probable allowed
-action (argmax of the masked logits): a policy's evaluation is then a
-function of its weights and the episodes alone, and two checkpoints compare
-without the noise of their draws. ``greedy = false`` draws from the masked
-softmax with the step's key (the run's ``seed``), the behaviour PPO trained
-and measured in its curve; a policy whose greedy play loops (the same MOVE
-into a wall) may score better so.
+**Drawn by default.** ``greedy = false`` (the default) draws the action
+from the masked softmax with the step's key, the behaviour PPO trained and
+measured in its curve; like every random choice it follows the run's
+``seed``, so a run is the same bytes every time. ``greedy = true`` takes the
+most probable allowed action. Measured on the shipped benchmark (500
+episodes, locked costs): the shipped policy scores WSR@1.5 20.2 drawn and
+17.8 greedy; the earlier 2.1 M-step policy 11.2 and 10.4.
 
 **Cost-aware.** The vector carries the episode's question costs, so the
 agent plans with the costs it is charged (``--costs``, ``eval.costs``, and
@@ -55,14 +55,14 @@ from ignjax.arrays import pytree_dataclass
 from ignjax.protocol import LOCKED_COSTS
 from ignjax.sim import types as T
 
-SETTINGS = MappingProxyType({"checkpoint": "", "greedy": True})
+SETTINGS = MappingProxyType({"checkpoint": "", "greedy": False})
 """The agent's settings and their defaults (``[agents.learned]``)."""
 SETTING_DOCS = MappingProxyType({
     "checkpoint": "the trained policy: a checkpoint folder RUN/checkpoints/<update>, a training run folder (its newest "
                   "checkpoint) or an exported policy folder; empty: the policy shipped with ignjax "
                   "(ignjax/data/policy). run.json records its path and the SHA-256 of its weights.",
-    "greedy": "take the most probable allowed action; false: draw it from the policy's distribution with the step's "
-              "key.",
+    "greedy": "take the most probable allowed action; false (the default): draw it from the policy's distribution "
+              "with the step's key, as in training.",
 })
 
 
