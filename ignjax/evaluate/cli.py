@@ -334,12 +334,22 @@ def _fingerprint(args, sim, used: dict) -> str:
     return h.hexdigest()
 
 
+def _jax_agent_params(agents, llm_names, agent_values: dict, costs, sim) -> tuple[dict, dict]:
+    """Each JAX agent's parameters (a cost-aware agent plans with the costs it is charged) and what ``run.json``
+    records of them: every parameter's value, and of weights loaded from a checkpoint its path and digest."""
+    from ignjax.agents.params import make_params, param_record
+
+    params = {a.name: make_params(a, agent_values.get(a.name), costs=costs, config=sim) for a in agents
+              if a.name not in llm_names}
+    used = {a.name: param_record(a, agent_values.get(a.name), sim, params[a.name]) for a in agents if a.name in params}
+    return params, used
+
+
 def run(args, settings: dict | None = None, popts: PR.ProcessOptions = PR.ProcessOptions(),
         group: PR.ProcessGroup | None = None) -> int:
     # imported on use, so that --help and the other commands answer at once
     from tqdm.auto import tqdm
 
-    from ignjax.agents.params import make_params, param_record
     from ignjax.devices.parts import PartStore
     from ignjax.episodes.dataset import open_benchmark
     from ignjax.evaluate.runner import bucket_batches, plan_run
@@ -359,12 +369,7 @@ def run(args, settings: dict | None = None, popts: PR.ProcessOptions = PR.Proces
     except ConfigError as e:
         raise ConfigError(None, "--parts", e.reason) from None
     quiet = args.quiet or not group.main
-    # a cost-aware agent plans with the costs it is charged; run.json records every parameter's value, and of
-    # weights loaded from a checkpoint its path and digest
-    params = {a.name: make_params(a, st["agent_values"].get(a.name), costs=costs, config=sim) for a in agents
-              if a.name not in llm_names}
-    used: dict[str, dict] = {a.name: param_record(a, st["agent_values"].get(a.name), sim, params[a.name])
-                             for a in agents if a.name in params}
+    params, used = _jax_agent_params(agents, llm_names, st["agent_values"], costs, sim)
     store = PartStore(out_dir / "parts")
     if group.main:
         kept = store.prepare(_fingerprint(args, sim, used), args.resume)
