@@ -277,28 +277,58 @@ def _deserialise(entry: dict[str, np.ndarray], args: tuple):
 
 
 _THREAD = threading.local()
-_LISTENING = []
+_HOOKED = []
 
 
-def _jax_cache_hits() -> int:
-    """Programs this thread has loaded from JAX's persistent cache so far.
+def _hooks() -> None:
+    """Install, once per process, a listener counting each thread's loads from JAX's persistent cache and a
+    salt of JAX's cache key that is this thread's program key while :func:`load_or_compile` compiles.
 
-    XLA:CPU cannot serialise again an executable it loaded from a serialised
-    form: the copy misses kernels, and a fresh process that loads it fails
-    when it runs ("Function ... not found"). So a program JAX's cache
-    already held (compiled by an earlier ignjax version, or before this
-    store existed) is not stored; it goes on loading from JAX's cache after
-    tracing."""
+    XLA:CPU cannot serialise again an executable it loaded from a serialised form: the copy misses kernels,
+    and a fresh process that loads it fails when it runs ("Function ... not found"). So a program is stored
+    only when it was compiled in the run. The salt makes JAX's entry of a stored program its own: a program
+    JAX's cache holds from before (an earlier ignjax version, the same program) is then a miss there and
+    compiles afresh once, and is stored, instead of loading from JAX's cache after tracing on every run. The
+    counts catch what the salt cannot (a stored entry deleted while JAX's stayed, or the executable JAX keeps
+    in memory from such a load): such a program is used, not stored. The salt goes through ``jax._src.cache_key.custom_hook``, JAX's hook for additions to its key,
+    chained to any hook already there; other programs' keys are unchanged."""
+    if _HOOKED:
+        return
     import jax
+    from jax._src import cache_key
 
-    if not _LISTENING:
-        def count(event, **_):
-            if event == "/jax/compilation_cache/cache_hits":
-                _THREAD.hits = getattr(_THREAD, "hits", 0) + 1
+    def count(event, **_):
+        if event == "/jax/compilation_cache/cache_hits":
+            _THREAD.hits = getattr(_THREAD, "hits", 0) + 1
 
-        jax.monitoring.register_event_listener(count)
-        _LISTENING.append(count)
-    return getattr(_THREAD, "hits", 0)
+    def count_compiles(event, start, end, **_):
+        if event == "/jax/core/compile/backend_compile_duration":
+            _THREAD.compiles = getattr(_THREAD, "compiles", 0) + 1
+
+    prior = cache_key.custom_hook
+
+    def salted() -> str:
+        salt = getattr(_THREAD, "salt", "")
+        return prior() + (f"ignjax-program:{salt}" if salt else "")
+
+    jax.monitoring.register_event_listener(count)
+    jax.monitoring.register_event_time_span_listener(count_compiles)
+    cache_key.custom_hook = salted
+    _HOOKED.append((count, salted))
+
+
+def _compile_fresh(lowered, key: str | None):
+    """``lowered.compile()`` with JAX's key salted by ``key``; and whether the backend compiled it here (not
+    loaded from JAX's persistent cache, nor handed back from JAX's memory, where it may be such a load):
+    see :func:`_hooks`."""
+    _hooks()
+    hits, compiles = getattr(_THREAD, "hits", 0), getattr(_THREAD, "compiles", 0)
+    _THREAD.salt = key or ""
+    try:
+        program = lowered.compile()
+    finally:
+        _THREAD.salt = ""
+    return program, getattr(_THREAD, "hits", 0) == hits and getattr(_THREAD, "compiles", 0) == compiles + 1
 
 
 def load_or_compile(fn, args: tuple, static: dict, name: str, context=()):
@@ -323,9 +353,8 @@ def load_or_compile(fn, args: tuple, static: dict, name: str, context=()):
                 jax.monitoring.record_event_time_span(PROGRAM_LOAD_EVENT, t0, time.time(), fun_name=name)
                 return program
     lowered = fn.lower(*args, **static)
-    hits = _jax_cache_hits()
-    program = lowered.compile()
-    if key is not None and _jax_cache_hits() == hits:  # compiled here, not loaded from JAX's cache
+    program, fresh = _compile_fresh(lowered, key)
+    if key is not None and fresh:
         entry = _serialise(lowered, program)
         if entry is not None:
             store.put(name, key, entry)

@@ -61,6 +61,10 @@ def test_a_stored_program_is_loaded_whole_and_gives_the_same_bytes(store):
     assert clock.whole == 1 and clock.names[-1] == "scaled"
     chex.assert_trees_all_equal(jax.device_get(first(*args)), jax.device_get(again(*args)))
     assert float(again(*args)["sum"][1]) == N + 1
+    for p in (store.root / "scaled").glob("*.npz"):
+        p.unlink()
+    PR.load_or_compile(_scaled, args, {"n": N}, "scaled")  # JAX's memory hands it back: it may be a load, not stored
+    assert not list((store.root / "scaled").glob("*.npz"))
 
 
 def test_the_key_follows_every_input_of_the_trace(store):
@@ -103,40 +107,50 @@ def test_a_program_jax_cannot_serialise_runs_and_is_not_stored(store):
 
 
 def test_a_damaged_or_foreign_entry_is_compiled_again_with_a_warning(store):
-    args = _args()
-    PR.load_or_compile(_scaled, args, {"n": N}, "scaled")
-    key = PR.program_key(_scaled, args, {"n": N})
+    args = _args()  # n = N + 10: a program no earlier test compiled (JAX's memory would hand it back unstored)
+    PR.load_or_compile(_scaled, args, {"n": N + 10}, "scaled")
+    key = PR.program_key(_scaled, args, {"n": N + 10})
     path = store.path("scaled", key)
     path.write_bytes(path.read_bytes()[:-100])  # truncated: its checksum cannot match
+    jax.clear_caches()  # as in a new process (JAX's memory would hand back the executable, which is not stored)
     with pytest.warns(CacheWarning, match="damaged|checksum"):
-        program = PR.load_or_compile(_scaled, args, {"n": N}, "scaled")
-    assert float(program(*args)["sum"][1]) == N + 1
+        program = PR.load_or_compile(_scaled, args, {"n": N + 10}, "scaled")
+    assert float(program(*args)["sum"][1]) == N + 11
     entry = ArrayStore(store.root).get("scaled", key)  # rewritten whole by the compile
     entry["executable"] = entry["executable"][::-1].copy()  # a valid entry whose executable will not load
     ArrayStore(store.root).put("scaled", key, entry)
+    jax.clear_caches()
     with pytest.warns(CacheWarning, match="does not load"):
-        program = PR.load_or_compile(_scaled, args, {"n": N}, "scaled")
-    assert float(program(*args)["sum"][1]) == N + 1
+        program = PR.load_or_compile(_scaled, args, {"n": N + 10}, "scaled")
+    assert float(program(*args)["sum"][1]) == N + 11
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # the rewritten entry loads again, quietly
-        PR.load_or_compile(_scaled, args, {"n": N}, "scaled")
+        PR.load_or_compile(_scaled, args, {"n": N + 10}, "scaled")
 
 
-def test_a_program_jax_loaded_from_its_own_cache_is_not_stored(store):
-    """XLA:CPU cannot serialise again an executable it loaded (the copy
-    misses kernels and fails in a fresh process), so a program JAX's own
-    persistent cache held is used, not stored."""
+def test_jax_cache_entries_of_stored_programs_are_their_own(store):
+    """A program JAX's own cache already holds (compiled by a plain jit, as an
+    earlier version would have) is compiled afresh and stored: JAX's key of a
+    program compiled for the store is salted with the store's key. And one that
+    JAX does load from its cache (its stored entry deleted) is used, not stored:
+    XLA:CPU cannot serialise again an executable it loaded (the copy misses
+    kernels and fails in a fresh process)."""
     args = _args(6)
     was = jax.config.jax_persistent_cache_min_compile_time_secs
     jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
     try:
-        _scaled.lower(*args, n=N + 2).compile()  # into JAX's cache
-        jax.clear_caches()  # else JAX hands back the executable it compiled (in memory), which is storable
-        program = PR.load_or_compile(_scaled, args, {"n": N + 2}, "scaled")  # out of it
+        _scaled.lower(*args, n=N + 2).compile()  # into JAX's cache, unsalted
+        jax.clear_caches()  # else JAX hands back the executable it holds in memory
+        PR.load_or_compile(_scaled, args, {"n": N + 2}, "scaled")
+        stored = list((store.root / "scaled").glob("*.npz"))
+        assert len(stored) == 1, "a program JAX's cache held from a plain compile was not compiled for the store"
+        stored[0].unlink()
+        jax.clear_caches()
+        program = PR.load_or_compile(_scaled, args, {"n": N + 2}, "scaled")  # JAX's salted entry: a hit
     finally:
         jax.config.update("jax_persistent_cache_min_compile_time_secs", was)
     assert float(program(*args)["sum"][1]) == N + 3
-    assert not (store.root / "scaled").exists()
+    assert not list((store.root / "scaled").glob("*.npz"))
 
 
 def test_the_store_is_off_with_the_compilation_cache(store):
