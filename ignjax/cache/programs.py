@@ -61,7 +61,7 @@ import numpy as np
 
 from ignjax.cache.clock import PROGRAM_LOAD_EVENT
 from ignjax.cache.folder import cache_root
-from ignjax.cache.store import ArrayStore, CacheWarning, code_digest, digest
+from ignjax.cache.store import ArrayStore, CacheWarning, array_digest, code_digest, digest
 
 PROGRAMS_BOUND_BYTES = 2 << 30
 """Size bound of the program store (a rollout program is about 6 MB)."""
@@ -130,8 +130,6 @@ def stable(x):
     if isinstance(x, (frozenset, set)):
         return ("set",) + tuple(sorted(repr(stable(v)) for v in x))
     if isinstance(x, np.ndarray):
-        from ignjax.cache.store import array_digest
-
         return ("ndarray", x.dtype.str, x.shape, array_digest(x).hex())
     if isinstance(x, np.generic):
         return ("np", x.dtype.str, repr(x.item()))
