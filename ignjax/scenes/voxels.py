@@ -126,85 +126,127 @@ class _Voxelizer:
         i1 = np.floor((hi - self.lo) / self.cell).astype(np.int64)
         return np.maximum(i0, 0), np.minimum(i1, self.dims - 1)
 
-    def box(self, center, rot, half) -> tuple[np.ndarray, np.ndarray]:
-        """Voxels overlapping an oriented box (separating-axis test).
+    def prim_voxels(self, rows: np.ndarray, chunk: int = 1 << 19):
+        """Voxels overlapping each primitive's oriented bounding box
+        (separating-axis test), many primitives at a time.
 
-        Returns:
-            idx: (M, 3) voxel (ix, iy, iz) indices overlapping the box; an
-                upright box is grown by :data:`_TOUCH` vertically (a voxel its
-                top or bottom face merely touches is included, for horizontal
-                rays at exactly that height), any other box in every direction.
-            strict: (M,) bool, the voxel overlaps the box shrunk by
-                :data:`_SHRINK` (what occupancy and navigation use).
+        Args:
+            rows: (P, 18) primitives (:data:`PRIM_COLUMNS`).
+            chunk: about how many candidate voxels one yielded piece covers.
+
+        Yields:
+            ``(idx, strict, pid)``: (M, 3) voxel (ix, iy, iz) indices, each
+            overlapping primitive ``pid`` (M,) of ``rows``; an upright box is
+            grown by :data:`_TOUCH` vertically (a voxel its top or bottom face
+            merely touches is included, for horizontal rays at exactly that
+            height), any other box in every direction. ``strict`` (M,) bool:
+            the voxel overlaps the box shrunk by :data:`_SHRINK` (what
+            occupancy and navigation use). A primitive's voxels all come in
+            one piece.
         """
-        center = np.asarray(center, dtype=np.float64)
-        rot = np.asarray(rot, dtype=np.float64).reshape(3, 3)
-        half = np.asarray(half, dtype=np.float64)
-        grown = half + _TOUCH
-        shrunk = np.maximum(half - _SHRINK, 0.0)
-        ext = np.abs(rot) @ grown
-        i0, i1 = self._range(center - ext, center + ext)
-        if np.any(i1 < i0):
-            return np.zeros((0, 3), np.int64), np.zeros(0, bool)
-        vh = self.cell / 2
-        if abs(abs(rot[2, 2]) - 1.0) < 1e-9:
-            # upright: 2-D separating axes in xy, exact z intervals
-            xs = np.arange(i0[0], i1[0] + 1)
-            ys = np.arange(i0[1], i1[1] + 1)
-            dx = (self.lo[0] + (xs + 0.5) * self.cell[0])[None, :] - center[0]
-            dy = (self.lo[1] + (ys + 0.5) * self.cell[1])[:, None] - center[1]
-            u, v = rot[:2, 0], rot[:2, 1]
-            ok_s = np.ones((len(ys), len(xs)), bool)
-            for ax in (np.array([1.0, 0.0]), np.array([0.0, 1.0]), u, v):
-                sep = np.abs(dx * ax[0] + dy * ax[1]) - (vh[0] * abs(ax[0]) + vh[1] * abs(ax[1]))
-                ok_s &= sep <= shrunk[0] * abs(ax @ u) + shrunk[1] * abs(ax @ v)
-            yy, xx = np.nonzero(ok_s)
-            if len(xx) == 0:
-                return np.zeros((0, 3), np.int64), np.zeros(0, bool)
-            zs = np.arange(i0[2], i1[2] + 1)
-            zc = self.lo[2] + (zs + 0.5) * self.cell[2]
-            z_s = np.abs(zc - center[2]) <= vh[2] + shrunk[2]
-            n = len(zs)
-            idx = np.stack([np.repeat(xs[xx], n), np.repeat(ys[yy], n), np.tile(zs, len(xx))], -1)
-            strict = np.tile(z_s, len(xx))
-            return idx, strict
-        grids = np.meshgrid(*[np.arange(a, b + 1) for a, b in zip(i0, i1)], indexing="ij")
-        idx = np.stack([g.ravel() for g in grids], -1)
-        d = self.lo + (idx + 0.5) * self.cell - center
-        # the 15 separating axes: world axes, box axes and their cross products
-        cross = np.cross(np.eye(3)[:, None, :], rot.T[None, :, :]).reshape(9, 3)
-        norm = np.linalg.norm(cross, axis=1)
-        axes = np.concatenate([np.eye(3), rot.T, cross[norm > 1e-9] / norm[norm > 1e-9, None]])  # Shape: (A, 3)
-        sep = np.abs(d @ axes.T) - np.abs(axes) @ vh  # Shape: (M, A)
-        proj = np.abs(axes @ rot)  # Shape: (A, 3): |axis . box axis j|
-        ok_g = np.all(sep <= proj @ grown, axis=1)
-        ok_s = np.all(sep <= proj @ shrunk, axis=1)
-        return idx[ok_g], ok_s[ok_g]
+        boxes = [_box_params(self, r, p) for p, r in enumerate(rows)]
+        for upright in (True, False):
+            sel = [p for p, b in enumerate(boxes) if b is not None and b.upright == upright]
+            size = [int(np.prod(boxes[p].i1 - boxes[p].i0 + 1)) for p in sel]
+            lo = 0
+            while lo < len(sel):
+                hi, total = lo + 1, size[lo]
+                while hi < len(sel) and total + size[hi] <= chunk:
+                    total += size[hi]
+                    hi += 1
+                part = [boxes[p] for p in sel[lo:hi]]
+                yield self._upright(part) if upright else self._general(part)
+                lo = hi
 
-    def sub_box(self, idx: np.ndarray, row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Quantised bounds (in 1/SUB_Q voxel) of a primitive's bounding box
-        (grown by :data:`_TOUCH`) within each voxel: (M, 3) low and high
-        quarter indices such that the box lies in ``[lo, hi + 1] / SUB_Q``."""
-        c, R, h = row[0:3], row[3:12].reshape(3, 3), row[12:15]
-        ext = np.abs(R) @ (h + _TOUCH)
+    def _centres(self, idx: np.ndarray, axis: int) -> np.ndarray:
+        return self.lo[axis] + (idx + 0.5) * self.cell[axis]
+
+    def _upright(self, part: list) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`prim_voxels` of upright boxes: 2-D separating axes in xy, exact z intervals."""
+        i0 = np.stack([b.i0 for b in part])
+        n = np.stack([b.i1 for b in part]) - i0 + 1
+        owner, off = _ragged(n[:, 0] * n[:, 1])
+        xs = i0[owner, 0] + off % n[owner, 0]
+        ys = i0[owner, 1] + off // n[owner, 0]
+        cx = np.array([b.center[0] for b in part])[owner]
+        cy = np.array([b.center[1] for b in part])[owner]
+        dx = self._centres(xs, 0) - cx
+        dy = self._centres(ys, 1) - cy
+        ax = np.stack([b.axes for b in part])[owner]  # Shape: (N, 4, 2)
+        vterm = np.stack([b.vterm for b in part])[owner]
+        thr = np.stack([b.thr for b in part])[owner]
+        ok = np.ones(len(owner), bool)
+        for a in range(4):
+            sep = np.abs(dx * ax[:, a, 0] + dy * ax[:, a, 1]) - vterm[:, a]
+            ok &= sep <= thr[:, a]
+        owner, xs, ys = owner[ok], xs[ok], ys[ok]
+        cell, zoff = _ragged(n[owner, 2])
+        zs = i0[owner[cell], 2] + zoff
+        zc = self._centres(zs, 2)
+        cz = np.array([b.center[2] for b in part])
+        zlim = np.array([b.zlim for b in part])
+        pid = np.array([b.pid for b in part], np.int64)
+        o = owner[cell]
+        strict = np.abs(zc - cz[o]) <= zlim[o]
+        return np.stack([xs[cell], ys[cell], zs], -1), strict, pid[o]
+
+    def _general(self, part: list) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`prim_voxels` of other boxes: the 15 separating axes in 3-D."""
+        i0 = np.stack([b.i0 for b in part])
+        n = np.stack([b.i1 for b in part]) - i0 + 1
+        owner, off = _ragged(n.prod(1))
+        nyz = n[owner, 1] * n[owner, 2]
+        idx = np.stack([i0[owner, 0] + off // nyz, i0[owner, 1] + (off // n[owner, 2]) % n[owner, 1],
+                        i0[owner, 2] + off % n[owner, 2]], -1)
+        centre = np.stack([b.center for b in part])[owner]
+        d = self.lo + (idx + 0.5) * self.cell - centre
+        axes = np.stack([b.axes for b in part])[owner]  # Shape: (M, 15, 3), unused axes 0
+        sep = np.abs(np.einsum("mk,mak->ma", d, axes)) - np.stack([b.vterm for b in part])[owner]
+        ok_g = np.all(sep <= np.stack([b.thr for b in part])[owner], axis=1)
+        ok_s = np.all(sep <= np.stack([b.thr_s for b in part])[owner], axis=1)
+        pid = np.array([b.pid for b in part], np.int64)
+        return idx[ok_g], ok_s[ok_g], pid[owner[ok_g]]
+
+    def sub_boxes(self, idx: np.ndarray, centre: np.ndarray, ext: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Quantised bounds (in 1/SUB_Q voxel) of a bounding box (centre
+        ``centre[m]``, half extents ``ext[m]``) within voxel ``idx[m]``: (M, 3)
+        low and high quarter indices such that the box lies in
+        ``[lo, hi + 1] / SUB_Q``."""
         v0 = self.lo + idx * self.cell
-        lo = np.clip((c - ext - v0) / self.cell, 0.0, 1.0)
-        hi = np.clip((c + ext - v0) / self.cell, 0.0, 1.0)
+        lo = np.clip((centre - ext - v0) / self.cell, 0.0, 1.0)
+        hi = np.clip((centre + ext - v0) / self.cell, 0.0, 1.0)
         qlo = np.clip(np.floor(lo * SUB_Q), 0, SUB_Q - 1).astype(np.uint8)
         qhi = np.clip(np.ceil(hi * SUB_Q) - 1, 0, SUB_Q - 1).astype(np.uint8)
         return qlo, np.maximum(qhi, qlo)
 
-    def inside(self, idx: np.ndarray, row: np.ndarray) -> np.ndarray:
-        """(M,) bool: voxel lies entirely inside the primitive ``row`` (all
-        eight corners inside a convex set)."""
-        c, R, h, q = row[0:3], row[3:12].reshape(3, 3), row[12:15], row[15:18]
-        if len(idx) == 0 or 2 * h.min() + 2 * _SHRINK < self.cell.min():
-            return np.zeros(len(idx), bool)  # too thin to hold a whole voxel
-        corners = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)], np.float64)
-        pts = self.lo + (idx[:, None, :] + corners[None]) * self.cell  # Shape: (M, 8, 3)
-        loc = (pts - c) @ R  # local frame
-        ok = np.all(np.abs(loc) <= h + _SHRINK, axis=-1) & ((loc**2 * q).sum(-1) <= 1.0 + 1e-9)
-        return ok.all(1)
+    def inside(self, idx: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """(M,) bool: voxel ``idx[m]`` lies entirely inside primitive
+        ``rows[m]`` (all eight corners inside a convex set; never for a
+        primitive too thin to hold a whole voxel).
+
+        The box part is tested at the voxel's centre: its corners all lie in
+        the box exactly when, along each box axis ``j``, the centre's local
+        coordinate plus the voxel's half extent ``sum_i cell_i / 2 |R_ij|``
+        does; the quadric part (convex) is tested at the eight corners of the
+        voxels that pass."""
+        c, R, h, q = rows[:, 0:3], rows[:, 3:12].reshape(-1, 3, 3), rows[:, 12:15], rows[:, 15:18]
+        out = 2 * h.min(1) + 2 * _SHRINK >= self.cell.min()
+        m = np.nonzero(out)[0]
+        if len(m) == 0:
+            return out
+        d = self.lo + (idx[m] + 0.5) * self.cell - c[m]
+        loc = d[:, 0, None] * R[m, 0] + d[:, 1, None] * R[m, 1] + d[:, 2, None] * R[m, 2]
+        half = (self.cell / 2) @ np.abs(R[m])  # Shape: (M, 3)
+        ok = np.all(np.abs(loc) + half <= h[m] + _SHRINK, axis=1)
+        curved = ok & np.any(q[m] != 0, axis=1)
+        if curved.any():
+            k = m[curved]
+            corners = np.array([[i, j, l] for i in (0, 1) for j in (0, 1) for l in (0, 1)], np.float64)
+            pts = self.lo + (idx[k, None, :] + corners[None]) * self.cell - c[k, None]  # Shape: (K, 8, 3)
+            lc = np.einsum("kci,kij->kcj", pts, R[k])
+            ok[curved] = ((lc**2 * q[k, None]).sum(-1) <= 1.0 + 1e-9).all(1)
+        out[m] = ok
+        return out
 
     def triangles(self, verts: np.ndarray, faces: np.ndarray) -> np.ndarray:
         """(M, 3) voxel indices hit by samples of the triangles (spacing < 0.4 voxel)."""
@@ -226,6 +268,60 @@ class _Voxelizer:
         idx = np.floor((pts - self.lo) / self.cell).astype(np.int64)
         ok = np.all((idx >= 0) & (idx < self.dims), axis=1)
         return np.unique(idx[ok], axis=0)
+
+
+class _Box:
+    """One primitive's bounding box as :meth:`_Voxelizer.prim_voxels` tests it."""
+
+    __slots__ = ("pid", "center", "i0", "i1", "upright", "axes", "vterm", "thr", "thr_s", "zlim")
+
+
+def _box_params(vz: _Voxelizer, row: np.ndarray, pid: int) -> "_Box | None":
+    """The separating-axis test's per-primitive terms (None: no voxel in range)."""
+    center, rot, half = row[0:3], row[3:12].reshape(3, 3), row[12:15]
+    grown = half + _TOUCH
+    shrunk = np.maximum(half - _SHRINK, 0.0)
+    ext = np.abs(rot) @ grown
+    i0, i1 = vz._range(center - ext, center + ext)
+    if np.any(i1 < i0):
+        return None
+    b = _Box()
+    b.pid, b.center, b.i0, b.i1 = pid, center, i0, i1
+    b.upright = bool(abs(abs(rot[2, 2]) - 1.0) < 1e-9)
+    vh = vz.cell / 2
+    if b.upright:
+        u, v = rot[:2, 0], rot[:2, 1]
+        axes = [np.array([1.0, 0.0]), np.array([0.0, 1.0]), u, v]
+        b.axes = np.stack(axes)
+        b.vterm = np.array([vh[0] * abs(ax[0]) + vh[1] * abs(ax[1]) for ax in axes])
+        b.thr = np.array([shrunk[0] * abs(ax @ u) + shrunk[1] * abs(ax @ v) for ax in axes])
+        b.zlim = vh[2] + shrunk[2]
+        return b
+    cross = np.cross(np.eye(3)[:, None, :], rot.T[None, :, :]).reshape(9, 3)
+    norm = np.linalg.norm(cross, axis=1)
+    axes = np.concatenate([np.eye(3), rot.T, cross[norm > 1e-9] / norm[norm > 1e-9, None]])  # Shape: (A, 3)
+    proj = np.abs(axes @ rot)  # Shape: (A, 3): |axis . box axis j|
+    pad = 15 - len(axes)  # unused axes: 0, never separating
+    b.axes = np.concatenate([axes, np.zeros((pad, 3))])
+    b.vterm = np.concatenate([np.abs(axes) @ vh, np.zeros(pad)])
+    b.thr = np.concatenate([proj @ grown, np.full(pad, np.inf)])
+    b.thr_s = np.concatenate([proj @ shrunk, np.full(pad, np.inf)])
+    return b
+
+
+def _extents(rows: np.ndarray, grow: float) -> np.ndarray:
+    """(P, 3) half extents of the primitives' axis-aligned bounding boxes, grown by ``grow``."""
+    return np.stack([np.abs(r[3:12].reshape(3, 3)) @ (r[12:15] + grow) for r in rows]) if len(rows) else \
+        np.zeros((0, 3))
+
+
+def _ragged(counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(owner, offset)`` of ``sum(counts)`` items: item ``i`` is number
+    ``offset[i]`` of the ``counts[owner[i]]`` items of ``owner[i]``."""
+    counts = np.asarray(counts, np.int64)
+    owner = np.repeat(np.arange(len(counts)), counts)
+    starts = np.cumsum(counts) - counts
+    return owner, np.arange(len(owner)) - starts[owner]
 
 
 def _mesh_world(model: mujoco.MjModel, data: mujoco.MjData, geom: int) -> tuple[np.ndarray, np.ndarray]:
@@ -327,8 +423,7 @@ def voxelize(compiled, config, origin, shape, n_slices):
     n_lb = -(-n_slices // spb)
     prims: list[np.ndarray] = []
     prim_geom: list[int] = []
-    keys: list[np.ndarray] = []  # (column-segment key, prim index or -1 for meshes)
-    vals: list[np.ndarray] = []
+    keys: list[np.ndarray] = []  # column segment * primitive count + primitive index
     mesh_keys: list[np.ndarray] = []
     G = mujoco.mjtGeom
     for g in range(model.ngeom):
@@ -350,32 +445,29 @@ def voxelize(compiled, config, origin, shape, n_slices):
                 mesh_keys.append(np.unique((vox[:, 1] * W + vox[:, 0]) * n_lb + vox[:, 2] // spb))
             continue
         for row in geom_prims(model, data, g):
-            vox, strict = vz.box(row[0:3], row[3:12], row[12:15])
-            p = len(prims)
             prims.append(row)
             prim_geom.append(g)
-            if len(vox) == 0:
-                continue
-            occ_ray[vox[:, 2], vox[:, 1], vox[:, 0]] = True
-            qlo, qhi = vz.sub_box(vox, row)
-            at = (vox[:, 2], vox[:, 1], vox[:, 0])
-            np.minimum.at(sub_lo, at, qlo)
-            np.maximum.at(sub_hi, at, qhi)
-            sv = vox[strict]
-            occ[sv[:, 2], sv[:, 1], sv[:, 0]] = True
-            inner = sv[vz.inside(sv, row)]
-            full[inner[:, 2], inner[:, 1], inner[:, 0]] = True
-            k = np.unique((vox[:, 1] * W + vox[:, 0]) * n_lb + vox[:, 2] // spb)
-            keys.append(k)
-            vals.append(np.full(len(k), p, np.int64))
+    rows = np.stack(prims) if prims else np.zeros((0, N_PRIM_COLUMNS))
+    ext = _extents(rows, _TOUCH)
+    n_prims = max(len(rows), 1)
+    for vox, strict, pid in vz.prim_voxels(rows):
+        at = (vox[:, 2], vox[:, 1], vox[:, 0])
+        occ_ray[at] = True
+        qlo, qhi = vz.sub_boxes(vox, rows[pid, 0:3], ext[pid])
+        np.minimum.at(sub_lo, at, qlo)
+        np.maximum.at(sub_hi, at, qhi)
+        sv, spid = vox[strict], pid[strict]
+        occ[sv[:, 2], sv[:, 1], sv[:, 0]] = True
+        inner = sv[vz.inside(sv, rows[spid])]
+        full[inner[:, 2], inner[:, 1], inner[:, 0]] = True
+        seg = (vox[:, 1] * W + vox[:, 0]) * n_lb + vox[:, 2] // spb
+        keys.append(np.unique(seg * n_prims + pid))  # (segment, primitive) pairs, sorted by segment then primitive
     K = config.max_list
     n_seg = H * W * n_lb
     approx = np.zeros(n_seg, bool)
     if keys:
-        key = np.concatenate(keys)
-        val = np.concatenate(vals)
-        order = np.lexsort((val, key))
-        key, val = key[order], val[order]
+        pair = np.sort(np.concatenate(keys))
+        key, val = pair // n_prims, pair % n_prims
         count = np.bincount(key, minlength=n_seg)
         approx |= count > K
         keep = ~approx[key]
@@ -389,7 +481,7 @@ def voxelize(compiled, config, origin, shape, n_slices):
         seg_prims = np.zeros(0, np.int32)
     if mesh_keys:
         approx[np.concatenate(mesh_keys)] = True
-    prim_arr = np.stack(prims).astype(np.float32) if prims else np.zeros((0, N_PRIM_COLUMNS), np.float32)
+    prim_arr = rows.astype(np.float32)
     seg = (start.astype(np.int32).reshape(H, W, n_lb), count.astype(np.uint8).reshape(H, W, n_lb), seg_prims)
     sub = pack_sub_boxes(sub_lo, sub_hi)
     sub[~occ_ray] = 0
