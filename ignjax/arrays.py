@@ -58,6 +58,16 @@ def xp(*arrays):
     return np if all(isinstance(a, host) for a in arrays) else jnp
 
 
+def on_device(x, dtype=None) -> jax.Array:
+    """Host data (numpy arrays, lists, scalars) as a device array, like
+    ``jnp.asarray(x, dtype)`` (the same dtype, 64-bit types narrowed unless
+    x64 is on) but copied by ``jax.device_put``: ``jnp.asarray`` of host data
+    runs a small compiled program per shape and dtype, each compiled or
+    looked up in the compilation cache, which adds up when a benchmark's
+    tables are loaded."""
+    return jax.device_put(np.asarray(x, dtype))
+
+
 def parse_floats(text, n: int, where: str) -> tuple[float, ...]:
     """Numbers from comma-separated text (a command-line option).
 
@@ -126,4 +136,4 @@ def field_docs(cls: type) -> dict[str, str]:
     return docs
 
 
-__all__ = ["field_docs", "parse_assignment", "parse_floats", "pytree_dataclass", "xp"]
+__all__ = ["field_docs", "on_device", "parse_assignment", "parse_floats", "pytree_dataclass", "xp"]

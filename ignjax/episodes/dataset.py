@@ -27,6 +27,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ignjax.arrays import on_device
 from ignjax.cache.clock import in_phase
 from ignjax.episodes.difficulty import BIN_INDEX
 from ignjax.episodes.schema import read_episodes
@@ -145,13 +146,13 @@ def episode_specs(records: list[dict], bank: SceneBank, path: str | os.PathLike 
                          fact_attrs=attrs, fact_on=_cat(bank, facts.get("on")), fact_near=near,
                          region_category=_cat(bank, rec["oracle"].get("region_anchor")), valid=True))
     specs = EpisodeSpec(
-        scene=jnp.asarray([r["scene"] for r in rows], jnp.int32), target=jnp.asarray([r["target"] for r in rows], jnp.int32),
-        field=jnp.asarray([r["field"] for r in rows], jnp.int32), category=jnp.asarray([r["category"] for r in rows], jnp.int32),
-        start=jnp.asarray([r["start"] for r in rows], jnp.float32), difficulty=jnp.asarray([r["difficulty"] for r in rows], jnp.int32),
-        goal_room=jnp.asarray([r["goal_room"] for r in rows], jnp.int32),
-        fact_attrs=jnp.asarray([r["fact_attrs"] for r in rows], jnp.int32), fact_on=jnp.asarray([r["fact_on"] for r in rows], jnp.int32),
-        fact_near=jnp.asarray([r["fact_near"] for r in rows], jnp.int32),
-        region_category=jnp.asarray([r["region_category"] for r in rows], jnp.int32),
+        scene=on_device([r["scene"] for r in rows], jnp.int32), target=on_device([r["target"] for r in rows], jnp.int32),
+        field=on_device([r["field"] for r in rows], jnp.int32), category=on_device([r["category"] for r in rows], jnp.int32),
+        start=on_device([r["start"] for r in rows], jnp.float32), difficulty=on_device([r["difficulty"] for r in rows], jnp.int32),
+        goal_room=on_device([r["goal_room"] for r in rows], jnp.int32),
+        fact_attrs=on_device([r["fact_attrs"] for r in rows], jnp.int32), fact_on=on_device([r["fact_on"] for r in rows], jnp.int32),
+        fact_near=on_device([r["fact_near"] for r in rows], jnp.int32),
+        region_category=on_device([r["region_category"] for r in rows], jnp.int32),
         valid=jnp.ones(len(rows), bool),
     )
     return specs, list(pairs), np.asarray([r["field"] for r in rows], np.int32)
@@ -361,4 +362,4 @@ def compute_fields(bank: SceneBank, pairs: list[tuple[int, int]], batch: int = F
         h, w = grid.shape
         for (f, _), field in zip(items, fields):
             out[f, :h, :w] = field
-    return jnp.asarray(out)
+    return on_device(out)

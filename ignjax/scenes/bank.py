@@ -27,7 +27,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ignjax.arrays import pytree_dataclass
+from ignjax.arrays import on_device, pytree_dataclass
 from ignjax.errors import ConfigError
 from ignjax.scenes import vocab
 from ignjax.scenes.compile import CompileOptions, CompiledScene, compile_scene
@@ -273,11 +273,11 @@ def _pad_stack(items: Sequence[np.ndarray], fill, dtype) -> np.ndarray:
 
 def _grid_table(grids: Sequence[NavGrid]) -> GridTable:
     return GridTable(
-        navigable=jnp.asarray(_pad_stack([g.navigable for g in grids], False, bool)),
-        room=jnp.asarray(_pad_stack([g.room for g in grids], -1, np.int32)),
-        components=jnp.asarray(_pad_stack([g.components for g in grids], -1, np.int32)),
-        origin=jnp.asarray(np.stack([g.origin for g in grids]).astype(np.float32)),
-        shape=jnp.asarray(np.array([g.shape for g in grids], np.int32)),
+        navigable=on_device(_pad_stack([g.navigable for g in grids], False, bool)),
+        room=on_device(_pad_stack([g.room for g in grids], -1, np.int32)),
+        components=on_device(_pad_stack([g.components for g in grids], -1, np.int32)),
+        origin=on_device(np.stack([g.origin for g in grids]).astype(np.float32)),
+        shape=on_device(np.array([g.shape for g in grids], np.int32)),
         resolution=grids[0].config.resolution,
     )
 
@@ -314,9 +314,9 @@ def _instance_table(scenes: Sequence[Scene], categories: tuple[str, ...]) -> Ins
             center[s, i] = inst.bbox.center
             half[s, i] = inst.bbox.half_extents
             yaw[s, i] = inst.bbox.yaw
-    return InstanceTable(valid=jnp.asarray(valid), center=jnp.asarray(center), half_extents=jnp.asarray(half),
-                         yaw=jnp.asarray(yaw), structural=jnp.asarray(structural),
-                         **{k: jnp.asarray(v) for k, v in f.items()})
+    return InstanceTable(valid=on_device(valid), center=on_device(center), half_extents=on_device(half),
+                         yaw=on_device(yaw), structural=on_device(structural),
+                         **{k: on_device(v) for k, v in f.items()})
 
 
 def _room_table(scenes: Sequence[Scene]) -> RoomTable:
@@ -336,8 +336,8 @@ def _room_table(scenes: Sequence[Scene]) -> RoomTable:
             for b in nbrs:
                 if a in idx and b in idx:
                     adj[s, idx[a], idx[b]] = True
-    return RoomTable(valid=jnp.asarray(valid), label=jnp.asarray(label), center=jnp.asarray(center),
-                     adjacency=jnp.asarray(adj))
+    return RoomTable(valid=on_device(valid), label=on_device(label), center=on_device(center),
+                     adjacency=on_device(adj))
 
 
 def _door_table(scenes: Sequence[Scene]) -> DoorTable:
@@ -354,8 +354,8 @@ def _door_table(scenes: Sequence[Scene]) -> DoorTable:
             pos[s, i] = d.position
             rooms[s, i] = [idx.get(r, -1) if r is not None else -1 for r in d.rooms]
             width[s, i] = d.width
-    return DoorTable(valid=jnp.asarray(valid), position=jnp.asarray(pos), rooms=jnp.asarray(rooms),
-                     width=jnp.asarray(width))
+    return DoorTable(valid=on_device(valid), position=on_device(pos), rooms=on_device(rooms),
+                     width=on_device(width))
 
 
 # ---------------------------------------------------------------------------

@@ -10,11 +10,10 @@ from __future__ import annotations
 from typing import Sequence
 
 import jax
-import jax.numpy as jnp
 import mujoco
 import numpy as np
 
-from ignjax.arrays import pytree_dataclass
+from ignjax.arrays import on_device, pytree_dataclass
 from ignjax.scenes.navgrid import NavGrid
 from ignjax.scenes.voxels import N_PRIM_COLUMNS
 
@@ -143,6 +142,6 @@ def ray_grid(grids: NavGrid | Sequence[NavGrid], compiled=None) -> RayGrid:
                 (cfg.resolution, cfg.slice_height, cfg.list_band_height):
             raise ValueError("all grids of a RayGrid need the same resolution, slice_height and list_band_height")
     arrs = stack_ray_arrays([ray_grid_arrays(g, c) for g, c in zip(grids, compiled)])
-    return RayGrid(**{k: jnp.asarray(v) for k, v in arrs.items()}, resolution=cfg.resolution,
+    return RayGrid(**{k: on_device(v) for k, v in arrs.items()}, resolution=cfg.resolution,
                    slice_height=cfg.slice_height, slices_per_band=cfg.slices_per_list_band,
                    max_count=max(int(arrs["seg_count"].max(initial=0)), 1))

@@ -19,7 +19,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ignjax.arrays import pytree_dataclass
+from ignjax.arrays import on_device, pytree_dataclass
 from ignjax.cache import array_digest, code_digest, derived_store, digest
 from ignjax.devices import available_cores
 from ignjax.errors import ConfigError
@@ -106,7 +106,7 @@ def _inside_prims(prims: np.ndarray, pts: np.ndarray, grow: float = 0.0) -> np.n
 def probe_map(bank: SceneBank, config: T.SimConfig) -> jax.Array:
     """(S, FINE H, FINE W) uint8 probe bits on fine cells (see :class:`World`;
     computed on the host by :func:`_probe_bits`)."""
-    return jnp.asarray(_probe_bits(bank, config))
+    return on_device(_probe_bits(bank, config))
 
 
 def _probe_bits(bank: SceneBank, config: T.SimConfig) -> np.ndarray:
@@ -212,7 +212,7 @@ def remembered_probe_map(bank: SceneBank, config: T.SimConfig) -> jax.Array:
         while len(_PROBE_MAPS) > PROBE_MAPS_KEPT:
             _PROBE_MAPS.popitem(last=False)
     _PROBE_MAPS.move_to_end(key)
-    return jnp.asarray(hit)
+    return on_device(hit)
 
 
 def _fine_index(world: World, s, xy):
