@@ -143,7 +143,6 @@ def _scene_probe_bits(si: int, t: dict, origin: np.ndarray, resolution: float, s
                                                                            "seg_prims", "approx", "prims"))
     fr = resolution / FINE
     rows, cols = np.meshgrid(np.arange(H * FINE), np.arange(W * FINE), indexing="ij")
-    maxc = max(int(seg_count.max(initial=0)), 1)
     x = float(origin[0]) + (cols + 0.5) * fr
     y = float(origin[1]) + (rows + 0.5) * fr
     vc = np.floor((x - float(t["origin"][si, 0])) / r.resolution).astype(np.int64)
@@ -166,12 +165,14 @@ def _scene_probe_bits(si: int, t: dict, origin: np.ndarray, resolution: float, s
                 st = seg_start[si, pr, pc, band]
                 cnt = seg_count[si, pr, pc, band].astype(np.int64)
                 rough = approx[si, pr, pc, band]
-                idx = np.clip(st[:, None] + np.arange(maxc)[None], 0, seg_prims.shape[1] - 1)
-                ids = seg_prims[si, idx]
-                use = (np.arange(maxc)[None] < cnt[:, None]) & (ids >= 0)
-                rows_p = prims[si][:, np.clip(ids, 0, prims.shape[2] - 1)].transpose(1, 2, 0)  # (n, maxc, 18)
-                pts = np.stack([x[part], y[part], np.full(len(pr), h)], 1)
-                hit = np.any(_inside_prims(rows_p, pts, FINE_GROW * fr) & use, axis=1) | rough
+                # one row per (cell, listed primitive) pair, not cells x the longest list
+                owner = np.repeat(np.arange(len(pr)), cnt)
+                ids = seg_prims[si, st[owner] + (np.arange(len(owner)) - (np.cumsum(cnt) - cnt)[owner])]
+                owner, ids = owner[ids >= 0], ids[ids >= 0]
+                rows_p = prims[si][:, ids].T[:, None, :]  # (pairs, 1, 18)
+                pts = np.stack([x[part][owner], y[part][owner], np.full(len(owner), h)], 1)
+                inside_p = _inside_prims(rows_p, pts, FINE_GROW * fr)[:, 0]
+                hit = (np.bincount(owner[inside_p], minlength=len(pr)) > 0) | rough
                 occ = occ.copy()
                 occ[part] = hit
         bits |= (np.where(inside, occ, False).astype(np.uint8) << j)
