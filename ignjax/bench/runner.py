@@ -79,7 +79,8 @@ from ignjax.bench.timing import log
 from ignjax.cache import add_cache_arguments, apply_cache_arguments
 
 
-def main(argv=None) -> int:
+def build_parser() -> argparse.ArgumentParser:
+    """The command line's options (also read by the documentation's tests, which parse its commands)."""
     p = argparse.ArgumentParser(prog="python -m ignjax.bench", description=__doc__.split("\n\n")[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__)
     p.add_argument("--quick", action="store_true", help="fewer rays, the EIG and random agents only, K = 16 in the loop")
@@ -102,7 +103,11 @@ def main(argv=None) -> int:
                    help="only the time_to_result block: evaluate, a quick sweep and the in-the-loop sweep, each cold "
                         "and warm in fresh processes (ignjax.bench.time_to_result)")
     add_cache_arguments(p)
-    args = p.parse_args(argv)
+    return p
+
+
+def main(argv=None) -> int:
+    args = build_parser().parse_args(argv)
     apply_cache_arguments(args)
     # imported here, not at the top: the figures pull in jax, MuJoCo and the
     # simulator (about 5 s), which ``--help`` should not wait for

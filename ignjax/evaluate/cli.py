@@ -144,7 +144,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "the answer's rules is dropped for the template); same as --set llm.paraphrase=true")
     g.add_argument("--llm-naive-unbudgeted", action="store_true",
                    help="the -naive agents run with no question budget (the reading of the paper's naive rows, "
-                        "README 'Reading the paper's tables'); same as --set llm.naive_unbudgeted=true")
+                        "docs/protocol.md, 'Reading the paper's tables'); same as --set llm.naive_unbudgeted=true")
     g.add_argument("--llm-concurrency", type=int, default=None, help="requests in flight per endpoint (default 16)")
     g.add_argument("--llm-batch", type=int, default=64, help="episodes in flight at once (default 64; keep it at least twice "
                    "llm.concurrency x endpoints so every server slot has a request queued)")

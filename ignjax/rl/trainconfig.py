@@ -101,7 +101,7 @@ class EnvConfig:
         cost_scale: (low, high) of the drawn scale. The trainer's recipe draws from x0.02 (costs below a
             quarter of the locked ones in about 4 episodes in 10) so the policy learns what answers are worth
             before their price: drawn from x0.25, the same 20 M-step run stopped asking within 2 M steps and
-            never asked again (README).
+            never asked again (docs/agents.md, "Training").
         per_type_prob: probability that an episode's types draw their scales apart.
         tau: success threshold of the reward, m.
         shaping: weight of the potential-based distance shaping, per metre of geodesic progress (0: off; the

@@ -93,7 +93,7 @@ class SimConfig:
             (default): ``max_steps``, one per possible attempt (:attr:`trace_slots`).
         question_budget: questions beyond ``max_questions`` are refused; false:
             no question is ever refused (an unbudgeted protocol, as the
-            paper's naive rows read; README "Reading the paper's tables").
+            paper's naive rows read; docs/protocol.md, "Reading the paper's tables").
         upfront_description: the agent receives the target's full
             description (the Type-1 and Type-2 facts) at reset, charged as one
             Type-1 and one Type-2 question (counted in ``n_questions`` and

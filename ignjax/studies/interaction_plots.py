@@ -140,7 +140,7 @@ def plot_questions_per_difficulty(result: dict, path: str | os.PathLike, title: 
 
 
 DELTA_U_LABEL = "ΔU = (A_before − A_after) / A_before (%)"
-"""The y-label of the Delta-U figure: the README's definition, as plotted."""
+"""The y-label of the Delta-U figure: the definition of docs/sweep.md ("The studies"), as plotted."""
 
 
 def delta_u_figure(result: dict, title: str | None = None):

@@ -337,7 +337,7 @@ def _model_tables(ev: dict, cfg) -> list[str]:
     naive = [n for n in ev["model_totals"] if n.endswith("-naive")]
     if cfg.llm.naive_unbudgeted and naive:
         parts += [f"The naive-QA rows ({', '.join(naive)}) ran with no question budget (`llm.naive_unbudgeted`: "
-                  "the reading of the paper's naive rows, README \"Reading the paper's tables\"); every other "
+                  "the reading of the paper's naive rows, docs/protocol.md, \"Reading the paper's tables\"); every other "
                   "agent kept the budget.", ""]
     return parts
 

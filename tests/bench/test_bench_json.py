@@ -106,7 +106,7 @@ def check_time_to_result(block) -> None:
 
 
 PIECES_DECISIONS_WITHIN = 0.01
-"""How far the pieces' decision count may stray from the fused rollout's at B = 4096 (README: compiled apart, they
+"""How far the pieces' decision count may stray from the fused rollout's at B = 4096 (docs/performance.md: compiled apart, they
 can round a float differently and change a rare episode; 0.3% of the EIG agent's decisions on the 2-core CPU)."""
 
 

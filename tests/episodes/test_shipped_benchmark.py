@@ -1,6 +1,6 @@
-"""The shipped benchmark (``scenes/benchmark.jsonl.gz``) is what the README
-says it is: 500 episodes in 12 houses, 150 / 200 / 150 easy / medium / hard
-(the protocol's 30:40:30), and every episode's difficulty score and bin are
+"""The shipped benchmark (``scenes/benchmark.jsonl.gz``) is what the docs
+(docs/getting-started.md, docs/scenes.md) say it is: 500 episodes in 12
+houses, 150 / 200 / 150 easy / medium / hard (the protocol's 30:40:30), and every episode's difficulty score and bin are
 :mod:`ignjax.episodes.difficulty` of its stored factors under the
 protocol's alpha and thresholds; the factors themselves follow from the
 construction file's counts, rho and start distance."""
@@ -47,7 +47,7 @@ def test_difficulty_recomputes_from_the_stored_factors(records):
     np.testing.assert_allclose(score, [r["difficulty_score"] for r in records], rtol=0, atol=1e-12)
     bins = dif.difficulty_bin(score, DIFFICULTY_THRESHOLDS)
     np.testing.assert_array_equal(bins, [BIN_INDEX[r["difficulty"]] for r in records])
-    # the bins as the README words them: easy D < 0.30, medium < 0.60, hard otherwise
+    # the bins as docs/scenes.md ("Benchmark construction") words them: easy D < 0.30, medium < 0.60, hard otherwise
     manual = np.where(score < 0.30, 0, np.where(score < 0.60, 1, 2))
     np.testing.assert_array_equal(bins, manual)
 

@@ -1,4 +1,4 @@
-"""README: the API key named by ``--llm-key-env`` "is only ever put in the
+"""docs/mllm.md ("The key"): the API key named by ``--llm-key-env`` "is only ever put in the
 ``Authorization`` header: never in logs, outcomes, ``run.json``,
 checkpoints, transcripts or error messages". One ``python -m
 ignjax.evaluate`` (in process) of the ``navgpt`` agent (a caption call per view, a Planner call) against the

@@ -1,4 +1,4 @@
-"""README ("Paying for the samples a ray needs"): the rollout marches its
+"""docs/performance.md ("Paying for the samples a ray needs"): the rollout marches its
 rays in passes and probes a blocked row's alternative headings in order,
 and "the ``eig`` and ``random`` rollouts of the shipped benchmark at
 B = 4,096 are bitwise equal to those of the one-pass code".

@@ -10,8 +10,8 @@ the oracle's :class:`~ignjax.sim.types.Answer` (both on the allow-list
 :data:`ignjax.sim.types.AGENT_FIELDS`) and the episode's question costs
 (the environment's parameters, never the world): no target id, position or
 distance can enter it. :func:`obs_layout` names every slice of the vector,
-its size, the fields it is computed from and its meaning (the README's
-"Reinforcement learning" section prints it); a test checks that every
+its size, the fields it is computed from and its meaning (docs/agents.md,
+"Learned agents and the RL environment", lists them); a test checks that every
 source is an allow-listed field or :data:`COSTS_SOURCE`.
 
 Values are scaled to about [-1, 1] (distances by ``obs_range`` or

@@ -88,8 +88,8 @@ class LLMConfig:
             results, so it is part of a run's fingerprint.
         naive_unbudgeted: the naive-QA rows (agents whose name ends in
             ``-naive``) run with no question budget, the reading of the
-            paper's naive rows whose |Q| exceeds the budget (README "Reading
-            the paper's tables"); every other agent keeps the budget.
+            paper's naive rows whose |Q| exceeds the budget (docs/protocol.md,
+            "Reading the paper's tables"); every other agent keeps the budget.
             Changes results, so it is part of a run's fingerprint.
         prices: USD per 1M tokens, ``{"prompt": x, "completion": y}``.
         extra_body: extra keys merged into each request's JSON (for example

@@ -57,7 +57,7 @@ Type-2 answer. The numbers the model does see are its own: the front
 view's heading, its offset from the start (:attr:`Decision.offset`) and,
 with ``memory_style="graph"``, the place graph built from that offset.
 
-Variants (:data:`TANDEM_AGENTS`, README "MLLM agents"): ``tandem``;
+Variants (:data:`TANDEM_AGENTS`, docs/agents.md "MLLM agents"): ``tandem``;
 ``tandem-no-spmem`` (no Spatial Memory: belief updates dropped, the memory
 block not shown); ``tandem-no-qa`` (never asks; the target's full
 description given at reset, as the paper's QA-off row); ``tandem-no-spmem-no-qa``;
