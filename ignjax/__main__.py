@@ -21,11 +21,16 @@ COMMANDS = {
 }
 
 
-def main(argv: list[str] | None = None) -> int:
+def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python -m ignjax", description=__doc__.split("\n\n")[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter,
                                 epilog="commands:\n" + "\n".join(f"  python -m {c:16s} {d}" for c, d in COMMANDS.items()))
     p.add_argument("--version", action="version", version=f"ignjax {__version__}")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = build_parser()
     p.parse_args(argv)
     p.print_help()
     return 0

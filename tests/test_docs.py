@@ -37,7 +37,6 @@ import subprocess
 import sys
 from dataclasses import dataclass
 from pathlib import Path
-from unittest import mock
 
 import pytest
 
@@ -244,26 +243,6 @@ def commands_in(path: Path, text: str | None = None) -> list[Command]:
     return found
 
 
-class _Parsed(Exception):
-    """Raised by the patched ``parse_args`` of :func:`_parse_with_main` once the arguments parsed."""
-
-
-def _parse_with_main(module, args: list[str]) -> argparse.Namespace:
-    """The arguments as the module's ``main`` parses them, stopped right after parsing (for command lines that
-    build their parser inside ``main``)."""
-    original = argparse.ArgumentParser.parse_args
-
-    def parse_args(self, a=None, namespace=None):
-        raise _Parsed(original(self, a, namespace))
-
-    with mock.patch.object(argparse.ArgumentParser, "parse_args", parse_args):
-        try:
-            module.main(args)
-        except _Parsed as parsed:
-            return parsed.args[0]
-    raise AssertionError(f"{module.__name__}.main returned without parsing its arguments")
-
-
 def _settings_check(module: str, ns: argparse.Namespace, tmp: Path) -> None:
     """What the command checks of its settings before any work, where that needs no files of a run: the
     sweep's studies and configuration, the trainer's configuration, the evaluation's agents and ``--set``
@@ -302,10 +281,7 @@ def check_command(cmd: Command, tmp: Path) -> str | None:
     err = io.StringIO()
     try:
         with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
-            if hasattr(module, "build_parser"):
-                ns = module.build_parser().parse_args(list(cmd.args))
-            else:
-                ns = _parse_with_main(module, list(cmd.args))
+            ns = module.build_parser().parse_args(list(cmd.args))
             _settings_check(cmd.module, ns, tmp)
     except SystemExit as e:
         if e.code not in (0, None):  # --help and --version exit 0

@@ -546,9 +546,8 @@ class ScriptedServer:
 # ---------------------------------------------------------------------------
 
 
-def main(argv: list[str] | None = None) -> int:
-    """``python -m ignjax.agents.llm.serve``: run the test double until
-    SIGINT / SIGTERM."""
+def build_parser() -> argparse.ArgumentParser:
+    """The command line of :func:`main`."""
     ap = argparse.ArgumentParser(prog="python -m ignjax.agents.llm.serve",
                                  description="Scripted OpenAI-compatible chat server. A TEST DOUBLE: replies are "
                                              "computed from the request text by a script, not by a model.")
@@ -565,6 +564,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--slow-s", type=float, default=30.0, help="how long a 'slow' fault sleeps")
     ap.add_argument("--reject-response-format", action="store_true",
                     help="answer 400 to requests with response_format (like vLLM without guided decoding)")
+    return ap
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m ignjax.agents.llm.serve``: run the test double until
+    SIGINT / SIGTERM."""
+    ap = build_parser()
     args = ap.parse_args(argv)
     try:
         srv = ScriptedServer(model=args.model, latency=args.latency, jitter=args.jitter,
