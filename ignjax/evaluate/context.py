@@ -2,11 +2,11 @@
 
 The host loop (:mod:`ignjax.evaluate.hostloop`) gives each decision's
 :meth:`~ignjax.agents.llm.agent.LLMAgent.decide` one context: model calls
-with re-asks, counted in the episode's accounting and transcript (the loop's
-``_query``), the encoded image of one rendered view (the Grounder's, the
-captioner's and the self-check's), and notes the transcript keeps (the
-question's text, the controller rule that decided, a default after unusable
-replies).
+with re-asks, counted in the episode's accounting and transcript
+(:meth:`~ignjax.evaluate.decisions.DecisionMaker.query`), the encoded
+image of one rendered view (the Grounder's, the captioner's and the
+self-check's), and notes the transcript keeps (the question's text, the
+controller rule that decided, a default after unusable replies).
 """
 
 from __future__ import annotations
@@ -21,8 +21,8 @@ class DecisionContext:
     use for one decision: model calls with re-asks (:meth:`query`, counted
     in the episode's accounting and transcript) and the image of a view (:meth:`view_image`)."""
 
-    def __init__(self, loop, client: ChatClient, ep, d: Decision):
-        self._loop, self._client, self._ep, self._d = loop, client, ep, d
+    def __init__(self, maker, client: ChatClient, ep, d: Decision):
+        self._maker, self._client, self._ep, self._d = maker, client, ep, d
         self.defaulted = False
         self.question = ""
         self.rule: tuple[str, str] | None = None
@@ -48,8 +48,8 @@ class DecisionContext:
             LLMRequestError: the request kept failing (the episode ends with
                 stop reason ``model_failure``).
         """
-        n = self._loop.agent.reasks if reasks is None else int(reasks)
-        return await self._loop._query(self._client, self._ep, self._d, request, parse, role, n)
+        n = self._maker.agent.reasks if reasks is None else int(reasks)
+        return await self._maker.query(self._client, self._ep, self._d, request, parse, role, n)
 
     def view_image(self, k: int, grid: bool = True) -> ImagePart:
         """View ``k`` of this decision, encoded: with the numbered 8x8 grid (the Grounder's image, kept with the
@@ -62,10 +62,10 @@ class DecisionContext:
             raise ValueError("this decision carries no rendered views")
         if not 0 <= int(k) < rgb.shape[0]:
             raise ValueError(f"view {k} is outside the {rgb.shape[0]} views")
-        fmt, one = self._loop.views.image_format, rgb[int(k)][None]
-        data = encode_images(grounder_images(one) if grid else one, fmt, self._loop.views.quality)[0]
+        fmt, one = self._maker.views.image_format, rgb[int(k)][None]
+        data = encode_images(grounder_images(one) if grid else one, fmt, self._maker.views.quality)[0]
         img = ImagePart(data, "image/jpeg" if fmt == "jpeg" else "image/png")
-        if grid and self._ep.index < self._loop.save_images:
+        if grid and self._ep.index < self._maker.save_images:
             self._ep.images.append((self._d.step, img, "grounder"))
         return img
 

@@ -75,119 +75,45 @@ Determinism: an episode's course depends on its episode, its key (seed and
 index in the file), the simulator and the replies; not on its slot, the
 batch size or the order replies arrive in. Transcripts are written at the
 end sorted by episode and step.
+
+The pieces: :mod:`ignjax.evaluate.rows` (the jitted programs over chosen rows,
+what the host keeps of each running episode, the progress file's settings
+key), :mod:`ignjax.evaluate.decisions` (a row's decision: what it shows, the
+model calls that make it, the batch action it comes to); this module drives
+the rounds.
 """
 
 from __future__ import annotations
 
 import asyncio
 import dataclasses
-import hashlib
-import json
 import os
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ignjax.agents.llm.agent import ASK, Decision, LLMAgent, compass_degrees
+from ignjax.agents.llm.agent import ASK, LLMAgent
 from ignjax.agents.llm.cache import ResponseCache
 from ignjax.agents.llm.client import ChatClient
-from ignjax.agents.llm.messages import ChatRequest, ImagePart, LLMRequestError
 from ignjax.agents.llm.config import LLMConfig
 from ignjax.episodes.dataset import EpisodeSet
 from ignjax.errors import ConfigError
-from ignjax.evaluate import accounting as A
-from ignjax.evaluate import candidates as C
-from ignjax.evaluate.accounting import ACCOUNTING
 from ignjax.evaluate import records as R
-from ignjax.evaluate.context import DecisionContext
+from ignjax.evaluate.decisions import DecisionMaker
 from ignjax.evaluate.records import LoopResult
 from ignjax.evaluate.recovery import ProgressLog
-from ignjax.evaluate.textobs import last_move_text, observation_text
+from ignjax.evaluate.rows import (EpisodeState, RunState, abort_rows, observe_rows, outcome_rows, reset_all,
+                                  reset_rows, settings_hash, step_rows)
 from ignjax.fileio import atomic_write
 from ignjax.protocol import LOCKED_COSTS
-from ignjax.scenes import vocab
 from ignjax.sim import env as E
 from ignjax.sim import oracle_text as OT
 from ignjax.sim import types as T
-from ignjax.sim.rollout import episode_keys, step_record
+from ignjax.sim.rollout import episode_keys
 from ignjax.sim.views import ViewConfig
-
-@dataclass
-class _Episode:
-    index: int
-    memory: object
-    answers: list = field(default_factory=list)
-    calls: list = field(default_factory=list)
-    acc: dict = field(default_factory=A.new_accounting)
-    failure: str = ""
-    progress: str = ""  # the active route hint's report after the last step (Decision.hint_report)
-    images: list = field(default_factory=list)
-    unread: list = field(default_factory=list)  # indices into answers still to paraphrase (llm.paraphrase)
-    front: tuple | None = None  # what the pending decision showed of its front view, to resolve a Type-4 cell
-
-
-@dataclass
-class _Run:
-    """The state of one :meth:`HostLoop.run`: episodes still queued (popped from the end), the episode in each
-    row, each running episode's trajectory rows, the finished episodes' records, and the decisions applied."""
-
-    queue: list
-    slots: list
-    traj_rows: dict = field(default_factory=dict)
-    records: dict = field(default_factory=dict)
-    decisions: int = 0
-
-
-def _settings_hash(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, sim: T.SimConfig, views: ViewConfig, seed: int,
-                   costs) -> str:
-    blob = json.dumps({"episodes": es.episode_ids, "agent": agent.name, "agent_options": vars(agent),
-                       "llm": {k: v for k, v in llm.public_dict().items() if k not in ("endpoints", "concurrency",
-                                                                                         "cache_dir", "replay")},
-                       "sim": sim.to_dict(), "views": dataclasses.asdict(views.replace(workers=1)), "seed": seed,
-                       "costs": [float(c) for c in costs]}, sort_keys=True, default=str)
-    return hashlib.sha256(blob.encode()).hexdigest()[:16]
-
-
-# The loop's jitted pieces take the world as an argument (its configuration is
-# static), so every loop over the same world shapes reuses one compilation.
-@jax.jit
-def _reset_rows(world, specs, keys, mask, states):
-    new = jax.vmap(lambda s, k: E.reset(world, s, k))(specs, keys)
-    return T.tree_select(mask, new, states)
-
-
-@jax.jit
-def _reset_all(world, specs, keys):
-    return jax.vmap(lambda s, k: E.reset(world, s, k))(specs, keys)
-
-
-@jax.jit
-def _step_rows(world, states, actions, mask):
-    """Step the rows in ``mask`` (the others stay as they are) and their trajectory records."""
-    obs = E.observe_all(world, states)
-    after = T.tree_select(mask, E.step_batch(world, states, actions), states)
-    kind = jnp.where(states.done | ~mask, -1, jnp.clip(actions.kind, 0, 2))
-    return after, step_record(obs, actions, kind, states, after, world.config.n_views)
-
-
-@jax.jit
-def _abort_rows(states, mask):
-    return dataclasses.replace(states, done=states.done | mask,
-                               stop_reason=jnp.where(mask & ~states.done, T.ABORTED, states.stop_reason))
-
-
-@jax.jit
-def _observe_rows(world, states):
-    return E.observe_all(world, states)
-
-
-@jax.jit
-def _outcome_rows(world, states):
-    return jax.vmap(lambda s: E.outcome(world, s))(states)
 
 
 class HostLoop:
@@ -208,10 +134,7 @@ class HostLoop:
         self.B = max(1, min(int(batch), self.n))
         self.render_rows = max(1, llm.concurrency * len(llm.endpoints) // 2)
         self.keys = episode_keys(seed, es.key_index)
-        self.names = self._view_names()
         self.categories = es.bank.categories
-        self._structural = np.asarray(es.bank.instances.structural)
-        self._centers = np.asarray(es.bank.instances.center)
         self.renderer, self._own_renderer = None, False
         if agent.renders and renderer is not None:
             if renderer.bank is not es.bank or renderer.sim != sim or renderer.config != views:
@@ -222,211 +145,25 @@ class HostLoop:
             from ignjax.sim.views import ViewRenderer
 
             self.renderer, self._own_renderer = ViewRenderer(es.bank, sim, views), True
+        self.maker = DecisionMaker(es, agent, sim=sim, views=views, costs=self.costs, save_images=save_images,
+                                   renderer=self.renderer)
         w = self.world
-        self._reset = lambda *a: _reset_rows(w, *a)
-        self._reset_all = lambda *a: _reset_all(w, *a)
-        self._step = lambda *a: _step_rows(w, *a)
-        self._abort = _abort_rows
-        self._observe = lambda st: _observe_rows(w, st)
-        self._outcome = lambda st: _outcome_rows(w, st)
+        self._reset = lambda *a: reset_rows(w, *a)
+        self._reset_all = lambda *a: reset_all(w, *a)
+        self._step = lambda *a: step_rows(w, *a)
+        self._abort = abort_rows
+        self._observe = lambda st: observe_rows(w, st)
+        self._outcome = lambda st: outcome_rows(w, st)
 
-    def _view_names(self):
-        from ignjax.sim.views.compose import view_names
-
-        return view_names(self.sim.n_views)
-
-    # -- per-row host work ----------------------------------------------------
-    def _prepare(self, rows, slots, states, obs) -> list[dict]:
-        """What the decisions of ``rows`` need, taken from this round's state
-        and observation (a row's entries stay as they are until its decision
-        is made, so the panels may be rendered later, while other rows step)."""
-        scene = np.asarray(states.episode.scene)
-        pose = np.asarray(states.pose)
-        step = np.asarray(states.step)
-        qleft = np.asarray(obs["questions_left"])
-        ans = jax.tree.map(np.asarray, states.answers)
-        out = []
-        for r in rows:
-            ep = slots[r]
-            percept = {"open": obs["free_space"][r].min(axis=-1).tolist(), "odometry": obs["odometry"][r][:2].tolist(),
-                       "room": int(obs["room_label"][r]), "known": ans.known[r].tolist(),
-                       "goal_room": int(ans.room_label[r]) if ans.known[r][1] else -1, "confirm": int(ans.confirm[r]),
-                       "follow_up": int(ans.follow_up[r]), "hint_active": bool(ans.hint_active[r]),
-                       "hint_progress": int(ans.hint_progress[r]), "hint_bearing": int(ans.hint_bearing[r]),
-                       "blocked": obs["blocked"][r].tolist(),
-                       "moved": float(obs["last_move"][r])}
-            rec = self.es.records[ep.index]
-            text = front = None
-            if self.agent.observation == "text":  # the objects in sight, placed in front-view cells (Type-4 candidates)
-                handles = obs["visible_handle"][r]
-                cells = C.front_cells(self.sim, pose[r], self._centers[scene[r]][np.maximum(handles, 0)])
-                front = ("projection", cells, handles, obs["visible_range"][r])
-                text = observation_text(obs, r, self.categories, self.names, cells)
-            last_kind = ep.calls[-1]["action"][0] if ep.calls and ep.calls[-1].get("action") else -1
-            out.append({"row": r, "scene": int(scene[r]), "pose": pose[r].copy(), "front": front, "decision": dict(
-                episode=rec["episode_id"], step=int(step[r]), max_steps=self.sim.max_steps,
-                goal=vocab.category_display(rec["target_category"]), questions_left=int(qleft[r]),
-                costs=self.costs, answers=tuple(ep.answers),
-                last_move=last_move_text(obs, r, last_kind), hint_report=ep.progress,
-                n_views=self.sim.n_views, view_fov=self.sim.view_hfov, observation=text, percept=percept,
-                heading=compass_degrees(pose[r][2]), offset=tuple(float(v) for v in obs["odometry"][r][:2]))})
-        return out
-
-    def _decisions(self, items: list[dict], slots) -> list[tuple[int, Decision]]:
-        """``(row, Decision)`` of prepared ``items`` (render, compose and encode their panels)."""
-        panels, v = [None] * len(items), None
-        if self.agent.renders and items:
-            from ignjax.sim.views.encode import encode_images
-
-            v = self.renderer.render(np.asarray([it["scene"] for it in items]),
-                                     np.stack([it["pose"] for it in items]))
-            fmt = self.views.image_format
-            data = encode_images(self.renderer.panels(v), fmt, self.views.quality)
-            mime = "image/jpeg" if fmt == "jpeg" else "image/png"
-            panels = [ImagePart(b, mime) for b in data]
-            rgb = list(v.rgb) if self.agent.uses_views else [None] * len(items)
-        else:
-            rgb = [None] * len(items)
-        out = []
-        for i, (it, panel, views) in enumerate(zip(items, panels, rgb)):
-            ep = slots[it["row"]]
-            ep.front = ("segmentation", v.instance[i, 0], it["scene"]) if v is not None else it["front"]
-            d = Decision(panel=panel, views=views, **it["decision"])
-            if panel is not None and ep.index < self.save_images:
-                ep.images.append((d.step, panel, "panel"))
-            out.append((it["row"], d))
-        return out
-
-    async def _decide(self, client: ChatClient, ep: _Episode, d: Decision):
-        """One decision (the agent's :meth:`~ignjax.agents.llm.agent.LLMAgent.decide`
-        with a :class:`~ignjax.evaluate.context.DecisionContext`): ``("act", tuple)`` or ``("fail", reason)``."""
-        try:
-            d = await self._paraphrase(client, ep, d)
-            ctx = DecisionContext(self, client, ep, d)
-            first = len(ep.calls)
-            act = tuple(int(x) for x in await self.agent.decide(ctx, ep.memory, d))
-        except LLMRequestError as e:
-            return "fail", str(e)
-        if len(ep.calls) == first:  # decided by the agent's controller alone: no model call
-            rule, text = ctx.rule or ("controller", "")
-            ep.calls.append(A.controller_record(self.agent.name, d, act, rule, text))
-        elif ctx.rule:
-            ep.calls[-1]["rule"], ep.calls[-1]["text"] = ctx.rule
-        ep.calls[-1]["action"] = list(act)
-        if act[0] == ASK and self.agent.writes_questions:
-            ep.calls[-1]["question"] = ctx.question
-        if ctx.defaulted:
-            ep.calls[-1]["error"] = "invalid replies: default action taken"
-        return "act", act
-
-    async def _paraphrase(self, client: ChatClient, ep: _Episode, d: Decision) -> Decision:
-        """``d`` with the answers the agent has not read yet reworded by the model where the rewording passes
-        the checks (module docstring, ``llm.paraphrase``)."""
-        if not ep.unread:
-            return d
-        for i in ep.unread:
-            q, template = ep.answers[i]
-            req = ChatRequest(messages=OT.paraphrase_messages(q, template), schema=OT.PARAPHRASE_SCHEMA,
-                              schema_name="paraphrase", tag=d.episode)
-            text = await self._query(client, ep, d, req, _paraphrase_reply, "paraphrase", 0)
-            leaks = ["unusable reply"] if text is None else OT.paraphrase_leaks(q, text, template)
-            if leaks:
-                ep.acc["paraphrase_rejected"] += 1
-                why = ep.calls[-1]["error"] if text is None else "; ".join(leaks)
-                ep.calls[-1]["error"] = f"paraphrase refused, template used: {why}"
-            else:
-                ep.answers[i] = (q, text)
-        ep.unread = []
-        return dataclasses.replace(d, answers=tuple(ep.answers))
-
-    async def _query(self, client: ChatClient, ep: _Episode, d: Decision, req, parse, role: str, reasks: int):
-        """One model call with its re-asks: ``parse(parsed, parse_error) -> (value, error)``;
-        the value, or None when every reply was unusable (each counted invalid)."""
-        earlier, res = [], None
-        for attempt in range(reasks + 1):
-            try:
-                res = await client.complete(req)
-            except LLMRequestError as e:
-                A.count_failed_call(ep.acc, e)
-                ep.calls.append(A.call_record(self.agent.name, d, req, None, None, earlier, str(e), role=role))
-                raise
-            A.count_reply(ep.acc, res)
-            value, err = parse(res.parsed, res.parse_error)
-            if value is not None:
-                ep.calls.append(A.call_record(self.agent.name, d, req, res, None, earlier, None, role=role))
-                return value
-            A.count_unusable(ep.acc, err)
-            earlier.append({"reply": res.text, "error": err, "request_hash": res.request_hash})
-            if attempt < reasks:
-                req = self.agent.correction(ep.memory, d, req, res.text, err)
-        ep.calls.append(A.call_record(self.agent.name, d, req, res, None, earlier[:-1],
-                                      f"invalid replies: {earlier[-1]['error']}", role=role))
-        return None
-
-    # -- applying the replies ---------------------------------------------------
-    def _actions(self, ready: dict, slots):
-        """The batch's :class:`~ignjax.sim.types.Action` from this round's replies ``ready`` (row ->
-        ``("act", tuple)`` or ``("fail", reason)``), with the Type-4 candidates resolved
-        (:mod:`ignjax.evaluate.candidates`): ``(action, acts (B, 5), candidates (B,), step_mask, fail_mask)``."""
-        B = self.B
-        acts = np.zeros((B, 5), np.int32)
-        acts[:, 3] = 1
-        acts[:, 4] = 1
-        cand = np.full(B, T.ANY_CANDIDATE, np.int32)
-        step_mask, fail_mask = np.zeros(B, bool), np.zeros(B, bool)
-        for r, (what, value) in ready.items():
-            if what == "act":
-                acts[r] = value
-                step_mask[r] = True
-                if acts[r, 0] == ASK and acts[r, 4] == 4:
-                    cand[r] = self._candidate(slots[r], int(acts[r, 2]), int(acts[r, 3]))
-            else:
-                fail_mask[r] = True
-                slots[r].failure = value
-        action = T.Action(kind=jnp.asarray(acts[:, 0]), direction=jnp.asarray(acts[:, 1]), col=jnp.asarray(acts[:, 2]),
-                          row=jnp.asarray(acts[:, 3]), question=jnp.asarray(acts[:, 4]), candidate=jnp.asarray(cand))
-        return action, acts, cand, step_mask, fail_mask
-
-    def _candidate(self, ep: _Episode, col: int, row: int) -> int:
-        """The instance a Type-4 question about front-view cell ``(col, row)`` asks about, from what the
-        decision was shown: the rendered segmentation, or the objects in sight placed in cells."""
-        if ep.front is None:
-            return T.NO_CANDIDATE
-        if ep.front[0] == "segmentation":
-            return C.segmented_candidate(ep.front[1], self._structural[ep.front[2]], col, row)
-        return C.projected_candidate(*ep.front[1:], col, row)
-
-    def _answer(self, ep: _Episode, q: int, answers, r: int, step: int, pointed: bool) -> None:
-        """Append the oracle's answer to a question of type ``q`` in words (row ``r`` of ``answers``)."""
-        er = self.es.records[ep.index]
-        txt = OT.answer_text(
-            q, bool(answers.refused[r]), appearance=er["oracle"]["appearance"], region=er["oracle"]["region"],
-            hint_room_label=int(answers.hint_room_label[r]), hint_sector=int(answers.hint_sector[r]),
-            hint_landmark=int(answers.hint_landmark[r]), hint_in_room=bool(answers.hint_in_room[r]),
-            confirm=int(answers.confirm[r]), follow_up=int(answers.follow_up[r]), categories=self.categories,
-            key=f"{er['episode_id']}:{step}", pointed=pointed)
-        ep.answers.append((q, txt))
-        if self.llm.paraphrase and not answers.refused[r]:
-            ep.unread.append(len(ep.answers) - 1)
-
-    # -- the loop -------------------------------------------------------------
-    def _progress_bar(self, done: int):
-        if not self.progress:
-            return None
-        import sys
-
-        from tqdm.auto import tqdm
-
-        return tqdm(total=self.n, initial=done, desc=self.agent.name, unit="ep", file=sys.stderr, dynamic_ncols=True)
-
-    def _fill(self, run: _Run, states, free_rows):
+    # -- the episodes in the rows -----------------------------------------------
+    def _fill(self, run: RunState, states, free_rows):
         """Start the next queued episodes in ``free_rows``: ``(states, the rows started)``."""
         rows, idx = [], []
         for r in free_rows:
             if not run.queue:
                 break
             i = run.queue.pop()
-            ep = run.slots[r] = _Episode(i, self.agent.start(self.es.records[i]["episode_id"]))
+            ep = run.slots[r] = EpisodeState(i, self.agent.start(self.es.records[i]["episode_id"]))
             if self.sim.upfront_description:  # given at reset (and charged) as one Type-1 and one Type-2 answer
                 o = self.es.records[i]["oracle"]
                 ep.answers = [(1, o["appearance"]), (2, o["region"])]
@@ -443,7 +180,7 @@ class HostLoop:
         specs = jax.tree.map(lambda a: a[take], self.es.specs)
         return self._reset(specs, self.keys[take], jnp.asarray(mask), states), rows
 
-    def _note_step(self, run: _Run, acts, cand, step_mask, before_step, rec, pose, answers) -> None:
+    def _note_step(self, run: RunState, acts, cand, step_mask, before_step, rec, pose, answers) -> None:
         """Each stepped row's trajectory record, the oracle's answer in words and the active hint's report."""
         for r in np.flatnonzero(step_mask):
             ep = run.slots[r]
@@ -453,7 +190,20 @@ class HostLoop:
             ep.progress = OT.hint_report_text(int(answers.hint_progress[r]), int(answers.hint_bearing[r])) \
                 if answers.hint_active[r] else ""
 
-    def _retire(self, run: _Run, ended, outs, pose, log: ProgressLog, bar, client: ChatClient) -> None:
+    def _answer(self, ep: EpisodeState, q: int, answers, r: int, step: int, pointed: bool) -> None:
+        """Append the oracle's answer to a question of type ``q`` in words (row ``r`` of ``answers``)."""
+        er = self.es.records[ep.index]
+        txt = OT.answer_text(
+            q, bool(answers.refused[r]), appearance=er["oracle"]["appearance"], region=er["oracle"]["region"],
+            hint_room_label=int(answers.hint_room_label[r]), hint_sector=int(answers.hint_sector[r]),
+            hint_landmark=int(answers.hint_landmark[r]), hint_in_room=bool(answers.hint_in_room[r]),
+            confirm=int(answers.confirm[r]), follow_up=int(answers.follow_up[r]), categories=self.categories,
+            key=f"{er['episode_id']}:{step}", pointed=pointed)
+        ep.answers.append((q, txt))
+        if self.llm.paraphrase and not answers.refused[r]:
+            ep.unread.append(len(ep.answers) - 1)
+
+    def _retire(self, run: RunState, ended, outs, pose, log: ProgressLog, bar, client: ChatClient) -> None:
         """Record the episodes of rows ``ended`` (progress file, images) and free their slots."""
         for r in ended:
             ep = run.slots[r]
@@ -468,11 +218,30 @@ class HostLoop:
                                     f"retries {st.retries}", refresh=False)
                 bar.update(1)
 
-    async def _round(self, run: _Run, client: ChatClient, states, ready: dict, log: ProgressLog, bar):
+    def _write_images(self, ep: EpisodeState) -> None:
+        if self.out is None or not ep.images:
+            return
+        eid = self.es.records[ep.index]["episode_id"]
+        folder = self.out / "images" / self.agent.name / eid
+        for step, img, role in ep.images:
+            ext = "jpg" if img.mime == "image/jpeg" else "png"
+            atomic_write(folder / f"{step:03d}_{role}.{ext}", img.data)
+
+    # -- the loop -------------------------------------------------------------
+    def _progress_bar(self, done: int):
+        if not self.progress:
+            return None
+        import sys
+
+        from tqdm.auto import tqdm
+
+        return tqdm(total=self.n, initial=done, desc=self.agent.name, unit="ep", file=sys.stderr, dynamic_ncols=True)
+
+    async def _round(self, run: RunState, client: ChatClient, states, ready: dict, log: ProgressLog, bar):
         """Apply one round of replies ``ready``: step the rows, record what happened, retire the episodes that
         ended and start queued ones in their rows. Returns ``(states, the rows that need a decision)``."""
         loop = asyncio.get_running_loop()
-        action, acts, cand, step_mask, fail_mask = self._actions(ready, run.slots)
+        action, acts, cand, step_mask, fail_mask = self.maker.actions(ready, run.slots)
         run.decisions += int(step_mask.sum())
         before_step = await loop.run_in_executor(None, np.asarray, states.step)
         states, rec = await loop.run_in_executor(None, self._step, states, action, jnp.asarray(step_mask))
@@ -489,14 +258,46 @@ class HostLoop:
             states, refilled = await loop.run_in_executor(None, self._fill, run, states, ended)
         return states, sorted({int(r) for r in np.flatnonzero(step_mask & ~done_now)} | set(refilled))
 
+    async def _drive(self, run: RunState, client: ChatClient, states, log: ProgressLog, bar) -> None:
+        """Fill the rows and run rounds until every queued episode has ended: prepare the rows that need a
+        decision, render them one call at a time, send each rendered row's decision, and apply the replies
+        that have arrived whenever a reply or a render finishes."""
+        loop = asyncio.get_running_loop()
+        states, need = self._fill(run, states, list(range(self.B)))
+        tasks: dict = {}
+        waiting: list[dict] = []  # rows prepared for a decision, not yet rendered
+        render = None  # the one render in progress (its rows' panels), or None
+        while True:
+            if need:
+                waiting += await loop.run_in_executor(None, lambda st=states, rs=need: self.maker.prepare(
+                    rs, run.slots, st, jax.tree.map(np.asarray, dataclasses.asdict(self._observe(st)))))
+                need = []
+            if waiting and render is None:
+                # rendered while the loop keeps stepping rows whose replies arrive; rows that become
+                # ready meanwhile are rendered together in the next call (at most render_rows a call,
+                # oldest first, so the first requests leave while the rest render)
+                render = loop.run_in_executor(None, self.maker.render, waiting[:self.render_rows], run.slots)
+                waiting = waiting[self.render_rows:]
+            if not tasks and render is None:
+                break
+            done, _ = await asyncio.wait(list(tasks) + ([render] if render is not None else []),
+                                         return_when=asyncio.FIRST_COMPLETED)
+            if render in done:
+                for r, d in render.result():
+                    tasks[asyncio.ensure_future(self.maker.decide(client, run.slots[r], d))] = r
+                render = None
+            ready = {tasks.pop(t): t.result() for t in done if t in tasks}
+            if ready:
+                states, need = await self._round(run, client, states, ready, log, bar)
+
     async def run(self) -> LoopResult:
-        key = _settings_hash(self.es, self.agent, self.llm, self.sim, self.views, self.seed, self.costs)
+        key = settings_hash(self.es, self.agent, self.llm, self.sim, self.views, self.seed, self.costs)
         log = ProgressLog(None if self.out is None else self.out / "llm" / f"{self.agent.name}.progress.jsonl", key,
                           self.agent.name, self.n)
         finished, failed_before = log.load()
         log.open()
         B = self.B
-        run = _Run(queue=[i for i in reversed(range(self.n)) if i not in finished], slots=[None] * B)
+        run = RunState(queue=[i for i in reversed(range(self.n)) if i not in finished], slots=[None] * B)
         # every slot starts empty: a padding episode (valid False) is done at reset
         pad = jax.tree.map(lambda a: a[np.zeros(B, np.int64)], self.es.specs)
         pad = dataclasses.replace(pad, valid=jnp.zeros(B, bool))
@@ -504,36 +305,10 @@ class HostLoop:
         t_start = time.perf_counter()
         bar = self._progress_bar(len(finished))
         cache = ResponseCache(self.llm.cache_dir) if self.llm.cache_dir else None
-        loop = asyncio.get_running_loop()
         try:
             async with ChatClient(self.llm, cache=cache) as client:
                 t_stats0 = client.stats()
-                states, need = self._fill(run, states, list(range(B)))
-                tasks: dict = {}
-                waiting: list[dict] = []  # rows prepared for a decision, not yet rendered
-                render = None  # the one render in progress (its rows' panels), or None
-                while True:
-                    if need:
-                        waiting += await loop.run_in_executor(None, lambda st=states, rs=need: self._prepare(
-                            rs, run.slots, st, jax.tree.map(np.asarray, dataclasses.asdict(self._observe(st)))))
-                        need = []
-                    if waiting and render is None:
-                        # rendered while the loop keeps stepping rows whose replies arrive; rows that become
-                        # ready meanwhile are rendered together in the next call (at most render_rows a call,
-                        # oldest first, so the first requests leave while the rest render)
-                        render = loop.run_in_executor(None, self._decisions, waiting[:self.render_rows], run.slots)
-                        waiting = waiting[self.render_rows:]
-                    if not tasks and render is None:
-                        break
-                    done, _ = await asyncio.wait(list(tasks) + ([render] if render is not None else []),
-                                                 return_when=asyncio.FIRST_COMPLETED)
-                    if render in done:
-                        for r, d in render.result():
-                            tasks[asyncio.ensure_future(self._decide(client, run.slots[r], d))] = r
-                        render = None
-                    ready = {tasks.pop(t): t.result() for t in done if t in tasks}
-                    if ready:
-                        states, need = await self._round(run, client, states, ready, log, bar)
+                await self._drive(run, client, states, log, bar)
                 stats = client.stats()
                 util = client.utilisation(t_stats0)
                 wall = time.perf_counter() - t_start
@@ -552,16 +327,6 @@ class HostLoop:
                  "paraphrased": sum(c["role"] == "paraphrase" for r in records.values() for c in r["calls"]),
                  "paraphrase_rejected": sum(r["accounting"]["paraphrase_rejected"] for r in records.values())}
         return R.loop_result([records[i] for i in range(self.n)], stats, self.sim)
-
-    def _write_images(self, ep: _Episode) -> None:
-        if self.out is None or not ep.images:
-            return
-        eid = self.es.records[ep.index]["episode_id"]
-        folder = self.out / "images" / self.agent.name / eid
-        for step, img, role in ep.images:
-            ext = "jpg" if img.mime == "image/jpeg" else "png"
-            atomic_write(folder / f"{step:03d}_{role}.{ext}", img.data)
-
 
 
 def run_llm_agent(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, *, sim: T.SimConfig = T.SimConfig(),
@@ -613,12 +378,4 @@ def run_llm_agent(es: EpisodeSet, agent: LLMAgent, llm: LLMConfig, *, sim: T.Sim
     return asyncio.run(loop.run())
 
 
-def _paraphrase_reply(parsed, err):
-    """A paraphrase reply's text, or ``(None, why)``."""
-    text = parsed.get("text") if isinstance(parsed, dict) else None
-    if not isinstance(text, str) or not text.strip():
-        return None, err or "field 'text' must be a non-empty string"
-    return " ".join(text.split()), None
-
-
-__all__ = ["ACCOUNTING", "HostLoop", "LoopResult", "observation_text", "run_llm_agent"]
+__all__ = ["HostLoop", "LoopResult", "run_llm_agent"]
