@@ -111,20 +111,9 @@ import numpy as np
 from ignjax.errors import SceneError
 from ignjax.scenes import vocab
 from ignjax.scenes.io.procthor_assets import AssetInfo, resolve_assets
-from ignjax.scenes.model import (  # noqa: I001
-    room_containing,
-    Attributes,
-    Door,
-    Geom,
-    Instance,
-    OrientedBox,
-    Room,
-    Scene,
-    SceneMeta,
-    Wall,
-    polygon_problem,
-    validate_scene,
-)
+from ignjax.scenes.model import Attributes, Door, Geom, Instance, OrientedBox, Room, Scene, SceneMeta, Wall, room_containing
+from ignjax.scenes.model.polygons import polygon_problem
+from ignjax.scenes.model.validation import validate_scene
 
 __all__ = [
     "WALL_THICKNESS",
