@@ -183,10 +183,10 @@ def _round(values) -> list[float]:
 
 def inspect_summary(scene) -> dict:
     """The ``inspect --json`` object of one scene (the contract is in this
-    module's docstring): :func:`~ignjax.scenes.model.scene_summary` plus each
+    module's docstring): :func:`~ignjax.scenes.model.scenejson.scene_summary` plus each
     instance's box as ``center``, ``size`` (full extents) and ``yaw``."""
     # imported on use, so that --help and the other commands answer at once
-    from ignjax.scenes.model import scene_summary
+    from ignjax.scenes.model.scenejson import scene_summary
 
     doc = scene_summary(scene)
     boxes = {i.id: i.bbox for i in scene.objects}

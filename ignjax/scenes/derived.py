@@ -9,7 +9,7 @@ and :func:`~ignjax.scenes.geodesic.goal_fields` return, read from
 there and computed (then stored) when not, so the arrays are the same bytes
 whether the cache was cold, warm or off.
 
-Keys: the scene's lossless JSON (:func:`~ignjax.scenes.model.scene_to_json`)
+Keys: the scene's lossless JSON (:func:`~ignjax.scenes.model.scenejson.scene_to_json`)
 without its id and metadata,
 the compile options, the grid configuration (the field adds the instance,
 its room and the seed radius) and :func:`ignjax.cache.code_digest` of the
@@ -25,9 +25,11 @@ import numpy as np
 
 from ignjax.cache import code_digest, derived_store, digest
 from ignjax.scenes.geodesic import goal_fields
-from ignjax.scenes.model import SceneMeta, scene_to_json
+from ignjax.scenes.model import SceneMeta
+from ignjax.scenes.model.scenejson import scene_to_json
 from ignjax.scenes.navgrid import GridConfig, NavGrid, build_navgrid
 
+# ignjax.scenes.model is a package: its digest covers every module in it (elements, polygons, ...)
 _GRID_CODE = ("ignjax.scenes.model", "ignjax.scenes.vocab", "ignjax.scenes.compile", "ignjax.scenes.voxels",
               "ignjax.scenes.navgrid")
 _FIELD_CODE = _GRID_CODE + ("ignjax.scenes.geodesic",)

@@ -12,7 +12,8 @@ from collections import defaultdict, deque
 
 import numpy as np
 
-from ignjax.scenes.model import Instance, OrientedBox, Scene, _segments_cross
+from ignjax.scenes.model import Instance, OrientedBox, Scene
+from ignjax.scenes.model.polygons import _segments_cross
 
 
 def room_instances(scene: Scene, include_structural: bool = False) -> dict[str, list[str]]:

@@ -43,7 +43,8 @@ import numpy as np
 from scipy import ndimage
 
 from ignjax.errors import ConfigError, SceneError
-from ignjax.scenes.model import Scene, points_in_polygon
+from ignjax.scenes.model import Scene
+from ignjax.scenes.model.polygons import points_in_polygon
 from ignjax.scenes.voxels import march_codes, scene_extent, voxelize
 
 

@@ -86,19 +86,9 @@ from ignjax.scenes import vocab
 from ignjax.scenes.io.footprint import outline_hull
 from ignjax.scenes.io.formats import MESH_SUFFIXES, SIDECAR_SUFFIX
 from ignjax.scenes.io.names import category_from_name
-from ignjax.scenes.model import (  # noqa: I001
-    room_containing,
-    Attributes,
-    Geom,
-    Instance,
-    MeshData,
-    OrientedBox,
-    Room,
-    Scene,
-    SceneMeta,
-    polygon_problem,
-    validate_scene,
-)
+from ignjax.scenes.model import Attributes, Geom, Instance, MeshData, OrientedBox, Room, Scene, SceneMeta, room_containing
+from ignjax.scenes.model.polygons import polygon_problem
+from ignjax.scenes.model.validation import validate_scene
 
 __all__ = ["SIDECAR_SUFFIX", "MESH_SUFFIXES", "Sidecar", "sidecar_path", "read_sidecar", "load_mesh_scene"]
 

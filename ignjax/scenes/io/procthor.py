@@ -92,39 +92,32 @@ Objects
     object's room is the room whose polygon holds its footprint centre (or,
     for an object hung on a wall line, the nearest room within 0.3 m).
 
-The asset table and its command line are in :mod:`ignjax.scenes.io.procthor_assets`.
+The asset table and its command line are in :mod:`ignjax.scenes.io.procthor_assets`;
+the frame conversion in :mod:`~ignjax.scenes.io.procthor_frame`, walls, doors
+and windows in :mod:`~ignjax.scenes.io.procthor_walls`, typed reads of the
+JSON fields in :mod:`~ignjax.scenes.io.procthor_fields`.
 """
 
 from __future__ import annotations
 
 import gzip
 import json
-import math
 import os
 import zlib
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Iterator, Mapping, Sequence
+from typing import Any, Iterator, Mapping
 
 import numpy as np
 
 from ignjax.errors import SceneError
 from ignjax.scenes import vocab
 from ignjax.scenes.io.procthor_assets import AssetInfo, resolve_assets
-from ignjax.scenes.model import (  # noqa: I001
-    room_containing,
-    Attributes,
-    Door,
-    Geom,
-    Instance,
-    OrientedBox,
-    Room,
-    Scene,
-    SceneMeta,
-    Wall,
-    polygon_problem,
-    validate_scene,
-)
+from ignjax.scenes.io.procthor_fields import ReadContext
+from ignjax.scenes.io.procthor_frame import unity_to_world, unity_yaw, upright_box
+from ignjax.scenes.io.procthor_walls import read_building
+from ignjax.scenes.model import Attributes, Geom, Instance, OrientedBox, Room, Scene, SceneMeta, room_containing
+from ignjax.scenes.model.polygons import polygon_problem
+from ignjax.scenes.model.validation import validate_scene
 
 __all__ = [
     "WALL_THICKNESS",
@@ -144,8 +137,6 @@ ROOM_SNAP_DISTANCE = 0.3
 """An object whose footprint centre lies outside every room polygon (a
 painting on a wall line) is given the nearest room within this distance."""
 
-_WINDOW_RGBA = (0.62, 0.78, 0.90, 1.0)
-_DOOR_RGBA = (0.55, 0.40, 0.25, 1.0)
 _MATERIAL_KEYWORDS: tuple[tuple[str, str], ...] = (
     ("wood", "wood"), ("oak", "wood"), ("walnut", "wood"), ("pine", "wood"), ("parquet", "wood"),
     ("metal", "metal"), ("steel", "metal"), ("chrome", "metal"), ("brass", "metal"), ("alumin", "metal"),
@@ -161,125 +152,13 @@ _MATERIAL_KEYWORDS: tuple[tuple[str, str], ...] = (
 
 
 # ---------------------------------------------------------------------------
-# Frame conversion
+# Parsing helpers
 # ---------------------------------------------------------------------------
-
-
-def unity_to_world(point) -> np.ndarray:
-    """Unity (x, y, z), Y-up left-handed -> ours (x, z, y), Z-up right-handed.
-
-    Works on any array (..., 3).
-    """
-    p = np.asarray(point, dtype=np.float64)
-    return p[..., [0, 2, 1]]
 
 
 def _clean(v: float) -> float:
     """Round to a nanometre so that float noise (-1e-17) does not leak out."""
     return round(float(v), 9) + 0.0
-
-
-def _wrap(angle: float) -> float:
-    a = math.remainder(angle, 2.0 * math.pi)
-    return math.pi if a == -math.pi else a
-
-
-def unity_yaw(rotation_y_degrees: float) -> float:
-    """Our heading (radians, CCW from +x) of a ProcTHOR asset turned by
-    ``rotation.y`` degrees about Unity's up axis: ``pi/2 - radians(y)``.
-
-    The asset's forward axis (Unity ``+z``) is the direction the result
-    points along; see the module docstring for the derivation.
-    """
-    return _wrap(math.pi / 2.0 - math.radians(rotation_y_degrees))
-
-
-def _unity_rotation(rx: float, ry: float, rz: float) -> np.ndarray:
-    """Unity's Euler rotation (degrees, applied Z then X then Y) as a matrix
-    acting on Unity column vectors."""
-    x, y, z = (math.radians(v) for v in (rx, ry, rz))
-    cx, sx, cy, sy, cz, sz = math.cos(x), math.sin(x), math.cos(y), math.sin(y), math.cos(z), math.sin(z)
-    mx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
-    my = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
-    mz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
-    return my @ mx @ mz
-
-
-_CORNER_SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=np.float64)
-
-
-def _upright_box(center_u: np.ndarray, size_u: Sequence[float], rot_u: Sequence[float]) -> tuple[OrientedBox, float]:
-    """Upright box (ours) of an asset box centred at ``center_u`` (Unity)."""
-    rx, ry, rz = rot_u
-    yaw = unity_yaw(ry)
-    half = 0.5 * np.asarray(size_u, dtype=np.float64)
-    if abs(math.remainder(rx, 360.0)) < 1e-6 and abs(math.remainder(rz, 360.0)) < 1e-6:
-        c = unity_to_world(center_u)
-        return OrientedBox(tuple(c), (half[2], half[0], half[1]), yaw), yaw
-    corners_u = center_u + (_CORNER_SIGNS * half) @ _unity_rotation(rx, ry, rz).T
-    corners = unity_to_world(corners_u)
-    u = np.array([math.cos(yaw), math.sin(yaw)])
-    v = np.array([-math.sin(yaw), math.cos(yaw)])
-    c0 = unity_to_world(center_u)
-    d = corners[:, :2] - c0[:2]
-    pu, pv = d @ u, d @ v
-    cu, cv = 0.5 * (pu.max() + pu.min()), 0.5 * (pv.max() + pv.min())
-    cxy = c0[:2] + cu * u + cv * v
-    zlo, zhi = corners[:, 2].min(), corners[:, 2].max()
-    box = OrientedBox((cxy[0], cxy[1], 0.5 * (zlo + zhi)),
-                      (0.5 * (pu.max() - pu.min()), 0.5 * (pv.max() - pv.min()), 0.5 * (zhi - zlo)), yaw)
-    return box, yaw
-
-
-# ---------------------------------------------------------------------------
-# Parsing helpers
-# ---------------------------------------------------------------------------
-
-
-class _Ctx:
-    """Where errors point: the file and a prefix (``line 7, `` for JSONL)."""
-
-    def __init__(self, source: str, prefix: str = ""):
-        self.source = source
-        self.prefix = prefix
-
-    def err(self, where: str, reason: str) -> SceneError:
-        return SceneError(self.source, f"{self.prefix}{where}" if where else (self.prefix.rstrip(", .") or None), reason)
-
-    def num(self, value, where: str) -> float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise self.err(where, f"expected a number, got {value!r}")
-        v = float(value)
-        if not math.isfinite(v):
-            raise self.err(where, f"expected a finite number, got {value!r}")
-        return v
-
-    def obj(self, value, where: str) -> dict:
-        if not isinstance(value, dict):
-            raise self.err(where, f"expected a JSON object, got {type(value).__name__}")
-        return value
-
-    def lst(self, value, where: str) -> list:
-        if not isinstance(value, list):
-            raise self.err(where, f"expected a list, got {type(value).__name__}")
-        return value
-
-    def xyz(self, value, where: str, keys: str = "xyz", default: float | None = None) -> tuple[float, ...]:
-        d = self.obj(value, where)
-        out = []
-        for k in keys:
-            if k not in d:
-                if default is None:
-                    raise self.err(f"{where}.{k}", "missing")
-                out.append(default)
-            else:
-                out.append(self.num(d[k], f"{where}.{k}"))
-        return tuple(out)
-
-    def ident(self, value, where: str) -> str:
-        if isinstance(value, bool) or not isinstance(value, (str, int)) or value == "":
-            raise self.err(where, f"expected a non-empty string id, got {value!r}")
-        return str(value)
 
 
 def _material_class(value) -> str | None:
@@ -304,34 +183,13 @@ def _category_rgba(category: str) -> tuple[float, float, float, float]:
     return (round(r, 4), round(g, 4), round(b, 4), 1.0)
 
 
+
 # ---------------------------------------------------------------------------
 # Houses
 # ---------------------------------------------------------------------------
 
 
-@dataclass
-class _WallGroup:
-    """One physical wall segment (all ProcTHOR copies of it)."""
-
-    id: str
-    start: np.ndarray
-    end: np.ndarray
-    bottom: float
-    top: float
-    rooms: list[str]
-    empty: bool
-    holes: list[tuple[float, float, float]]  # (t0, t1, top) along start->end
-
-    @property
-    def length(self) -> float:
-        return float(np.hypot(*(self.end - self.start)))
-
-    @property
-    def direction(self) -> np.ndarray:
-        return (self.end - self.start) / max(self.length, 1e-12)
-
-
-def _parse_rooms(house: dict, ctx: _Ctx) -> list[Room]:
+def _parse_rooms(house: dict, ctx: ReadContext) -> list[Room]:
     rooms_raw = house.get("rooms")
     if rooms_raw is None or (isinstance(rooms_raw, list) and not rooms_raw):
         raise ctx.err("rooms", "the house has no rooms")
@@ -367,165 +225,8 @@ def _parse_rooms(house: dict, ctx: _Ctx) -> list[Room]:
     return rooms
 
 
-def _is_exterior_wall(wall_id: str | None, wall: dict | None) -> bool:
-    if wall_id is None:
-        return True
-    if wall_id.startswith("wall|exterior"):
-        return True
-    return wall is not None and wall.get("roomId") == "exterior"
 
-
-def _parse_walls(house: dict, ctx: _Ctx, room_ids: set[str]):
-    walls_raw = house.get("walls", [])
-    walls_raw = ctx.lst(walls_raw if walls_raw is not None else [], "walls")
-    groups: dict[tuple, _WallGroup] = {}
-    by_id: dict[str, tuple[tuple, dict, np.ndarray, np.ndarray]] = {}
-    for i, wraw in enumerate(walls_raw):
-        w = f"walls[{i}]"
-        ctx.obj(wraw, w)
-        wid = ctx.ident(wraw.get("id"), f"{w}.id")
-        poly = ctx.lst(wraw.get("polygon"), f"{w}.polygon")
-        pts = [ctx.xyz(p, f"{w}.polygon[{j}]") for j, p in enumerate(poly)]
-        if len(pts) < 3:
-            raise ctx.err(f"{w}.polygon", f"a wall polygon needs at least 3 points, got {len(pts)}")
-        feet: list[tuple[float, float]] = []
-        for x, _, z in pts:
-            if not any(abs(x - a) <= 1e-6 and abs(z - b) <= 1e-6 for a, b in feet):
-                feet.append((x, z))
-        if len(feet) != 2:
-            raise ctx.err(f"{w}.polygon", f"expected a vertical rectangle over a floor segment (2 distinct x/z "
-                                          f"positions), got {len(feet)}")
-        ys = [p[1] for p in pts]
-        bottom, top = min(ys), max(ys)
-        if top - bottom <= 1e-6:
-            raise ctx.err(f"{w}.polygon", "the wall has zero height")
-        start, end = np.array(feet[0]), np.array(feet[1])
-        key = tuple(sorted((round(x, 3), round(z, 3)) for x, z in feet))
-        room = wraw.get("roomId")
-        exterior = _is_exterior_wall(wid, wraw)
-        g = groups.get(key)
-        if g is None:
-            g = groups[key] = _WallGroup(wid, start, end, bottom, top, [], bool(wraw.get("empty", False)), [])
-        else:
-            g.empty = g.empty and bool(wraw.get("empty", False))
-            g.bottom, g.top = min(g.bottom, bottom), max(g.top, top)
-            if g.id.startswith("wall|exterior") and not exterior:
-                g.id = wid
-        if not exterior and isinstance(room, str) and room in room_ids and room not in g.rooms:
-            g.rooms.append(room)
-        if wid in by_id:
-            raise ctx.err(f"{w}.id", f"duplicate wall id {wid!r}")
-        by_id[wid] = (key, wraw, start, end)
-    # Exterior walls of the older schema carry the room id; keep rooms of
-    # walls seen only as exterior copies.
-    for wid, (key, wraw, _, _) in by_id.items():
-        room = wraw.get("roomId")
-        if not groups[key].rooms and isinstance(room, str) and room in room_ids:
-            groups[key].rooms.append(room)
-    return groups, by_id
-
-
-def _hole(ctx: _Ctx, d: dict, where: str) -> tuple[float, float, float, float]:
-    """(x0, x1, y0, y1) of a door/window hole in its wall0's frame."""
-    if "holePolygon" in d:
-        pts = ctx.lst(d["holePolygon"], f"{where}.holePolygon")
-        if len(pts) < 2:
-            raise ctx.err(f"{where}.holePolygon", f"expected two corner points, got {len(pts)}")
-        xy = [ctx.xyz(p, f"{where}.holePolygon[{j}]", "xy") for j, p in enumerate(pts)]
-        if "assetPosition" in d:
-            ctx.xyz(d["assetPosition"], f"{where}.assetPosition", default=0.0)
-    elif "boundingBox" in d:
-        bb = ctx.obj(d["boundingBox"], f"{where}.boundingBox")
-        xy = [ctx.xyz(bb.get("min"), f"{where}.boundingBox.min", "xy"),
-              ctx.xyz(bb.get("max"), f"{where}.boundingBox.max", "xy")]
-        if "assetOffset" in d:
-            ctx.xyz(d["assetOffset"], f"{where}.assetOffset", default=0.0)
-    else:
-        raise ctx.err(where, "has neither holePolygon (schema 1.0.0) nor boundingBox (schema 0.0.1)")
-    xs, ys = [p[0] for p in xy], [p[1] for p in xy]
-    x0, x1, y0, y1 = min(xs), max(xs), min(ys), max(ys)
-    if x1 - x0 <= 1e-6:
-        raise ctx.err(where, f"the hole has zero width ({x0} to {x1})")
-    if y1 - y0 <= 1e-6:
-        raise ctx.err(where, f"the hole has zero height ({y0} to {y1})")
-    return x0, x1, y0, y1
-
-
-def _place_hole(ctx: _Ctx, where: str, by_id, groups, wall0: str, x0: float, x1: float):
-    """Resolve a hole on ``wall0``: (group, t0, t1 along the group, centre xy, room of wall0)."""
-    if wall0 not in by_id:
-        raise ctx.err(f"{where}.wall0", f"refers to unknown wall {wall0!r}")
-    key, wraw, s, e = by_id[wall0]
-    g = groups[key]
-    length = float(np.hypot(*(e - s)))
-    tol = 1e-3
-    if x0 < -tol or x1 > length + tol:
-        raise ctx.err(where, f"the hole ({x0:.3f} to {x1:.3f} m) extends past wall {wall0!r} ({length:.3f} m long)")
-    x0, x1 = max(x0, 0.0), min(x1, length)
-    d = (e - s) / max(length, 1e-12)
-    centre = s + d * 0.5 * (x0 + x1)
-    same = np.allclose(s, g.start, atol=1e-3)
-    t0, t1 = (x0, x1) if same else (g.length - x1, g.length - x0)
-    return g, t0, t1, centre, wraw.get("roomId")
-
-
-def _cut_walls(groups: dict[tuple, _WallGroup], thickness: float) -> list[Wall]:
-    walls: list[Wall] = []
-    for g in groups.values():
-        if g.empty:
-            continue
-        height = g.top - g.bottom
-        rooms = tuple(g.rooms)
-        if not g.holes:
-            walls.append(Wall(g.id, tuple(g.start), tuple(g.end), thickness, height, g.bottom, rooms))
-            continue
-        holes = sorted(g.holes)
-        merged: list[list[float]] = []
-        for t0, t1, top in holes:
-            if merged and t0 <= merged[-1][1] + 1e-9:
-                merged[-1][1] = max(merged[-1][1], t1)
-                merged[-1][2] = max(merged[-1][2], top)
-            else:
-                merged.append([t0, t1, top])
-        d = g.direction
-
-        def at(t: float) -> tuple[float, float]:
-            p = g.start + d * t
-            return float(p[0]), float(p[1])
-
-        cursor, k = 0.0, 0
-        for t0, t1, top in merged:
-            if t0 - cursor > 1e-4:
-                walls.append(Wall(f"{g.id}#{k}", at(cursor), at(t0), thickness, height, g.bottom, rooms))
-                k += 1
-            if g.top - top > 1e-4:
-                walls.append(Wall(f"{g.id}#{k}", at(t0), at(t1), thickness, g.top - top, top, rooms))
-                k += 1
-            cursor = max(cursor, t1)
-        if g.length - cursor > 1e-4:
-            walls.append(Wall(f"{g.id}#{k}", at(cursor), at(g.length), thickness, height, g.bottom, rooms))
-    return walls
-
-
-def _inward_yaw(rooms_by_id: Mapping[str, Room], room: str | None, centre: np.ndarray, d: np.ndarray) -> float:
-    """Heading perpendicular to a wall (direction ``d``) pointing into ``room``."""
-    n = np.array([-d[1], d[0]])
-    r = rooms_by_id.get(room) if room else None
-    if r is not None and not bool(r.contains((centre + 0.05 * n)[None])[0]) and bool(r.contains((centre - 0.05 * n)[None])[0]):
-        n = -n
-    return math.atan2(n[1], n[0])
-
-
-def _wall_instance(iid: str, category: str, centre: np.ndarray, yaw: float, width: float, y0: float, y1: float,
-                   depth: float, room: str | None, name: str, rgba) -> Instance:
-    half = (0.5 * depth, 0.5 * width, 0.5 * (y1 - y0))
-    box = OrientedBox((float(centre[0]), float(centre[1]), 0.5 * (y0 + y1)), half, yaw)
-    geom = Geom("box", half, (0.0, 0.0, half[2]), rgba=rgba, part=category)
-    return Instance(iid, category, (float(centre[0]), float(centre[1]), y0), yaw, box, room=room,
-                    structural=True, geoms=(geom,), name=name)
-
-
-def _parse_objects(house: dict, ctx: _Ctx, assets: Mapping[str, AssetInfo], rooms: list[Room]) -> list[Instance]:
+def _parse_objects(house: dict, ctx: ReadContext, assets: Mapping[str, AssetInfo], rooms: list[Room]) -> list[Instance]:
     objs = house.get("objects", [])
     objs = ctx.lst(objs if objs is not None else [], "objects")
     out: list[Instance] = []
@@ -545,7 +246,7 @@ def _parse_objects(house: dict, ctx: _Ctx, assets: Mapping[str, AssetInfo], room
             raise ctx.err(f"{where}.assetId", f"unknown assetId {aid!r} (object {oid!r}): not in the ProcTHOR asset table")
         pos = np.array(ctx.xyz(o.get("position"), f"{where}.position"))
         rot = ctx.xyz(o["rotation"], f"{where}.rotation", default=0.0) if "rotation" in o else (0.0, 0.0, 0.0)
-        box, yaw = _upright_box(pos, info.size, rot)
+        box, yaw = upright_box(pos, info.size, rot)
         category = vocab.normalize_category(info.object_type)
         color = None
         rgba = _category_rgba(category)
@@ -581,86 +282,22 @@ def _parse_objects(house: dict, ctx: _Ctx, assets: Mapping[str, AssetInfo], room
     return out
 
 
-def _convert(house: Any, ctx: _Ctx, scene_id: str, assets: Mapping[str, AssetInfo], wall_thickness: float) -> Scene:
+def _convert(house: Any, ctx: ReadContext, scene_id: str, assets: Mapping[str, AssetInfo], wall_thickness: float) -> Scene:
     if not isinstance(house, dict):
         raise ctx.err("", f"a ProcTHOR house must be a JSON object, got {type(house).__name__}")
     meta = house.get("metadata") if isinstance(house.get("metadata"), dict) else {}
     schema = meta.get("schema") if isinstance(meta.get("schema"), str) else None
     rooms = _parse_rooms(house, ctx)
-    rooms_by_id = {r.id: r for r in rooms}
-    groups, by_id = _parse_walls(house, ctx, set(rooms_by_id))
-
-    doors: list[Door] = []
-    structural: list[Instance] = []
-    for i, d in enumerate(ctx.lst(house.get("doors") or [], "doors")):
-        w = f"doors[{i}]"
-        ctx.obj(d, w)
-        did = ctx.ident(d.get("id"), f"{w}.id")
-        wall0 = ctx.ident(d.get("wall0"), f"{w}.wall0")
-        wall1 = d.get("wall1")
-        x0, x1, y0, y1 = _hole(ctx, d, w)
-        g, t0, t1, centre, room0 = _place_hole(ctx, w, by_id, groups, wall0, x0, x1)
-        if room0 not in rooms_by_id:
-            room0 = d.get("room0") if d.get("room0") in rooms_by_id else (g.rooms[0] if g.rooms else None)
-        if room0 is None:
-            raise ctx.err(f"{w}.wall0", f"cannot tell which room door {did!r} belongs to")
-        w1raw = by_id[wall1][1] if isinstance(wall1, str) and wall1 in by_id else None
-        room1 = None
-        if not _is_exterior_wall(wall1 if isinstance(wall1, str) else None, w1raw):
-            cand = (w1raw or {}).get("roomId", d.get("room1"))
-            room1 = cand if cand in rooms_by_id and cand != room0 else None
-        asset = d.get("assetId") if isinstance(d.get("assetId"), str) else ""
-        openness = d.get("openness", 1)
-        openness = ctx.num(openness, f"{w}.openness") if openness is not None else 1.0
-        yaw = math.atan2(g.direction[1], g.direction[0])
-        if room1 is None and openness <= 0:
-            structural.append(_wall_instance(did, "door", centre, _inward_yaw(rooms_by_id, room0, centre, g.direction),
-                                             x1 - x0, 0.0, y1, wall_thickness + 0.02, room0, asset, _DOOR_RGBA))
-            continue
-        g.holes.append((t0, t1, y1))
-        info = assets.get(asset)
-        frame = info.object_type == "Doorframe" if info is not None else "doorframe" in asset.lower()
-        kind = "opening" if frame else "door"
-        doors.append(Door(did, (float(centre[0]), float(centre[1])), x1 - x0, yaw, (room0, room1), y1, kind))
-
-    for i, wd in enumerate(ctx.lst(house.get("windows") or [], "windows")):
-        w = f"windows[{i}]"
-        ctx.obj(wd, w)
-        wid = ctx.ident(wd.get("id"), f"{w}.id")
-        wall0 = ctx.ident(wd.get("wall0"), f"{w}.wall0")
-        x0, x1, y0, y1 = _hole(ctx, wd, w)
-        g, _, _, centre, room0 = _place_hole(ctx, w, by_id, groups, wall0, x0, x1)
-        if room0 not in rooms_by_id:
-            room0 = wd.get("room0") if wd.get("room0") in rooms_by_id else (g.rooms[0] if g.rooms else None)
-        asset = wd.get("assetId") if isinstance(wd.get("assetId"), str) else ""
-        info = assets.get(asset)
-        depth = max(wall_thickness + 0.02, info.size[2] if info is not None else 0.0)
-        structural.append(_wall_instance(wid, "window", centre, _inward_yaw(rooms_by_id, room0, centre, g.direction),
-                                         x1 - x0, y0, y1, depth, room0, asset, _WINDOW_RGBA))
-
-    for g in groups.values():
-        if not g.empty:
-            continue
-        a = g.rooms[0] if g.rooms else None
-        if a is None:
-            continue
-        b = g.rooms[1] if len(g.rooms) > 1 else None
-        mid = 0.5 * (g.start + g.end)
-        doors.append(Door(f"opening|{g.id}", (float(mid[0]), float(mid[1])), g.length,
-                          math.atan2(g.direction[1], g.direction[0]), (a, b), g.top - g.bottom, "opening"))
-
-    walls = _cut_walls(groups, wall_thickness)
-    instances = _parse_objects(house, ctx, assets, rooms) + structural
-    wall_height = max((g.top for g in groups.values()), default=2.5)
+    building = read_building(house, ctx, {r.id: r for r in rooms}, assets, wall_thickness)
+    instances = _parse_objects(house, ctx, assets, rooms) + building.instances
     params = json.dumps({"schema": schema, "wall_thickness": wall_thickness}, sort_keys=True)
-    scene = Scene(scene_id, tuple(rooms), tuple(doors), tuple(walls), tuple(instances),
+    scene = Scene(scene_id, tuple(rooms), tuple(building.doors), tuple(building.walls), tuple(instances),
                   SceneMeta(source=ctx.source, source_format="procthor", up_axis="Y", meters_per_unit=1.0, params=params),
-                  wall_height=wall_height)
+                  wall_height=building.wall_height)
     try:
         return validate_scene(scene, ctx.source)
     except SceneError as e:
         raise SceneError(ctx.source, f"{ctx.prefix}{e.where}" if e.where else None, e.reason) from e
-
 
 
 def house_to_scene(house: dict, *, source: str, scene_id: str,
@@ -683,7 +320,7 @@ def house_to_scene(house: dict, *, source: str, scene_id: str,
         SceneError: naming ``source``, the field (``objects[3].assetId``,
             ``rooms[1].floorPolygon``) and the reason.
     """
-    return _convert(house, _Ctx(str(source)), scene_id, resolve_assets(assets), float(wall_thickness))
+    return _convert(house, ReadContext(str(source)), scene_id, resolve_assets(assets), float(wall_thickness))
 
 
 def _suffix(p: Path) -> str:
@@ -726,7 +363,7 @@ def iter_procthor(path: str | os.PathLike, *, assets: Mapping[str, AssetInfo] | 
                         house = json.loads(line)
                     except json.JSONDecodeError as e:
                         raise SceneError(p, where, f"invalid JSON: {e.msg} (column {e.colno})") from e
-                    yield _convert(house, _Ctx(src, f"{where}, "), f"{stem}_{index}", table, float(wall_thickness))
+                    yield _convert(house, ReadContext(src, f"{where}, "), f"{stem}_{index}", table, float(wall_thickness))
         except UnicodeDecodeError as e:
             raise SceneError(p, None, f"not a text JSONL file ({e.reason})") from e
         except (OSError, EOFError, zlib.error) as e:
@@ -745,9 +382,9 @@ def iter_procthor(path: str | os.PathLike, *, assets: Mapping[str, AssetInfo] | 
         if not doc:
             raise SceneError(p, None, "the file holds an empty list of houses")
         for i, house in enumerate(doc):
-            yield _convert(house, _Ctx(src, f"[{i}]."), f"{stem}_{i}", table, float(wall_thickness))
+            yield _convert(house, ReadContext(src, f"[{i}]."), f"{stem}_{i}", table, float(wall_thickness))
         return
-    yield _convert(doc, _Ctx(src), stem, table, float(wall_thickness))
+    yield _convert(doc, ReadContext(src), stem, table, float(wall_thickness))
 
 
 def load_procthor(path: str | os.PathLike, *, assets: Mapping[str, AssetInfo] | str | os.PathLike | None = None,

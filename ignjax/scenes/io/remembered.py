@@ -23,7 +23,8 @@ from typing import Callable
 import numpy as np
 
 from ignjax.cache import code_digest, derived_store, digest
-from ignjax.scenes.model import Scene, scene_from_dict, scene_to_json
+from ignjax.scenes.model import Scene
+from ignjax.scenes.model.scenejson import scene_from_dict, scene_to_json
 
 
 def _file_digest(p: Path) -> str | None:

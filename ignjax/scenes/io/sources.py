@@ -6,7 +6,7 @@ source                                 reader
 directory with ``manifest.json``       every scene the manifest lists
 directory without a manifest           every supported file in it (sorted)
 ``.usd`` ``.usda`` ``.usdc`` ``.usdz``   :func:`ignjax.scenes.io.usd.load_usd`
-``.json`` (ignjax scene document)      :func:`ignjax.scenes.model.scene_from_dict`
+``.json`` (ignjax scene document)      :func:`ignjax.scenes.model.scenejson.scene_from_dict`
 ``.json`` (ProcTHOR house)             :func:`ignjax.scenes.io.procthor.load_procthor`
 ``.jsonl`` ``.jsonl.gz``               one ProcTHOR house per line
 ``.gltf`` ``.glb`` ``.obj``            :func:`ignjax.scenes.io.meshes.load_mesh_scene`
@@ -26,7 +26,8 @@ from ignjax.errors import SceneError, call_recording_warnings, warn_again
 from ignjax.scenes.io.formats import JSON_SUFFIXES, MESH_SUFFIXES, SIDECAR_SUFFIX, USD_SUFFIXES
 from ignjax.scenes.io.manifest import read_manifest
 from ignjax.scenes.io.remembered import read_remembered
-from ignjax.scenes.model import Scene, scene_from_dict
+from ignjax.scenes.model import Scene
+from ignjax.scenes.model.scenejson import scene_from_dict
 
 _USD_VERSION = importlib.metadata.version("usd-core")
 

@@ -29,7 +29,8 @@ import numpy as np
 
 from ignjax.errors import ConfigError
 from ignjax.scenes import vocab
-from ignjax.scenes.model import Room, Scene, SceneMeta, validate_scene
+from ignjax.scenes.model import Room, Scene, SceneMeta
+from ignjax.scenes.model.validation import validate_scene
 from ignjax.scenes.procgen import catalogue as cat
 from ignjax.scenes.procgen.catalogue import CategorySpec
 from ignjax.scenes.procgen.furnish import furnish

@@ -59,7 +59,8 @@ from pxr import Gf, Kind, Sdf, Tf, Usd, UsdGeom, UsdSemantics, UsdUtils, Vt
 from ignjax.errors import SceneError
 from ignjax.scenes.io.formats import USD_SUFFIXES
 from ignjax.scenes.io.usd.stage import ATTR_ID, ATTR_KIND, ISAAC_DATA_ATTR, ISAAC_TYPE_ATTR, LABELS_TAXONOMY, NS
-from ignjax.scenes.model import Door, Geom, Instance, Room, Scene, Wall, validate_scene
+from ignjax.scenes.model import Door, Geom, Instance, Room, Scene, Wall
+from ignjax.scenes.model.validation import validate_scene
 
 USD_FORMAT = "ignjax-scene-usd"
 """Value of ``customLayerData["ignjax"]["format"]`` in exported stages."""

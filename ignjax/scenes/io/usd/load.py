@@ -201,7 +201,8 @@ from ignjax.scenes.io.usd.stage import (
     warn_usd_messages,
 )
 from ignjax.scenes.io.usd.traversal import Owner, traverse
-from ignjax.scenes.model import Instance, Room, Scene, SceneMeta, validate_scene
+from ignjax.scenes.model import Instance, Room, Scene, SceneMeta
+from ignjax.scenes.model.validation import validate_scene
 
 
 _ASSET_ERRORS = frozenset(getattr(Pcp, name) for name in (
@@ -407,7 +408,7 @@ def load_usd(path: str | os.PathLike, *, scene_id: str | None = None, correct_la
     Raises:
         SceneError: not a USD file, unsupported ``upAxis``, no geometry,
             NaN/inf transforms or points, malformed meshes, or a scene that
-            fails :func:`~ignjax.scenes.model.validate_scene`.
+            fails :func:`~ignjax.scenes.model.validation.validate_scene`.
 
     Warns:
         UsdImportWarning: missing sublayers/references/payloads (the rest is

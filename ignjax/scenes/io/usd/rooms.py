@@ -17,7 +17,8 @@ from ignjax.scenes.io.usd.instances import InstanceBuilder
 from ignjax.scenes.io.usd.parts import Part, authored
 from ignjax.scenes.io.usd.stage import ATTR_ID, NS, warn_import
 from ignjax.scenes.io.usd.traversal import Owner
-from ignjax.scenes.model import Door, Instance, Room, Wall, points_in_polygon, polygon_area, polygon_problem
+from ignjax.scenes.model import Door, Instance, Room, Wall
+from ignjax.scenes.model.polygons import points_in_polygon, polygon_area, polygon_problem
 
 
 class Structure:

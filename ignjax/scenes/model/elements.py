@@ -1,4 +1,4 @@
-"""The host-side scene model.
+"""The scene model's elements: the dataclasses a scene is made of.
 
 A :class:`Scene` is what every scene source (procedural houses, USD stages,
 ProcTHOR houses, glTF/OBJ meshes) is turned into, and what compilation to
@@ -32,17 +32,17 @@ The room-object graph is derived, see :mod:`ignjax.scenes.graph`.
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 from dataclasses import dataclass, field
-from typing import Any, Iterable, Sequence
+from typing import Sequence
 
 import numpy as np
 
-from ignjax.errors import SceneError
-from ignjax.scenes import vocab
+from ignjax.scenes.model.polygons import Vec2, points_in_polygon, polygon_area, polygon_centroid, polygon_edge_distance
 
-Vec2 = tuple[float, float]
+__all__ = ["GEOM_KINDS", "MeshData", "Geom", "Attributes", "OrientedBox", "Instance", "Room", "Door", "Wall",
+           "SceneMeta", "Scene", "room_containing"]
+
 Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]
 
@@ -406,60 +406,6 @@ class Scene:
         return dataclasses.replace(self, **changes)
 
 
-# ---------------------------------------------------------------------------
-# Polygon helpers
-# ---------------------------------------------------------------------------
-
-
-def polygon_area(poly: Sequence[Vec2]) -> float:
-    """Signed area (positive when counter-clockwise)."""
-    p = np.asarray(poly, dtype=np.float64).reshape(-1, 2)
-    if len(p) < 3:
-        return 0.0
-    x, y = p[:, 0], p[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
-
-
-def polygon_centroid(poly: Sequence[Vec2]) -> Vec2:
-    p = np.asarray(poly, dtype=np.float64).reshape(-1, 2)
-    a = polygon_area(p)
-    if abs(a) < 1e-12:
-        m = p.mean(0)
-        return float(m[0]), float(m[1])
-    x, y = p[:, 0], p[:, 1]
-    xn, yn = np.roll(x, -1), np.roll(y, -1)
-    cross = x * yn - xn * y
-    cx = float(((x + xn) * cross).sum() / (6 * a))
-    cy = float(((y + yn) * cross).sum() / (6 * a))
-    return cx, cy
-
-
-def points_in_polygon(points, poly: Sequence[Vec2]) -> np.ndarray:
-    """Even-odd rule point-in-polygon for points (..., 2); vectorised."""
-    pts = np.asarray(points, dtype=np.float64)
-    shape = pts.shape[:-1]
-    pts = pts.reshape(-1, 2)
-    v = np.asarray(poly, dtype=np.float64).reshape(-1, 2)
-    x, y = pts[:, 0:1], pts[:, 1:2]
-    x0, y0 = v[:, 0][None], v[:, 1][None]
-    x1, y1 = np.roll(v[:, 0], -1)[None], np.roll(v[:, 1], -1)[None]
-    cond = (y0 > y) != (y1 > y)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        xint = x0 + (y - y0) * (x1 - x0) / (y1 - y0)
-    inside = np.logical_and(cond, x < xint).sum(axis=1) % 2 == 1
-    return inside.reshape(shape)
-
-
-def polygon_edge_distance(point, poly: Sequence[Vec2]) -> float:
-    """Distance from a 2-D point to the nearest edge of a polygon."""
-    p = np.asarray(point, dtype=np.float64)
-    v = np.asarray(poly, dtype=np.float64).reshape(-1, 2)
-    a, b = v, np.roll(v, -1, axis=0)
-    ab = b - a
-    t = np.clip(((p - a) * ab).sum(1) / np.maximum((ab * ab).sum(1), 1e-18), 0.0, 1.0)
-    return float(np.hypot(*(a + t[:, None] * ab - p).T).min())
-
-
 def room_containing(rooms: Sequence["Room"], xy, snap: float = 0.0) -> str | None:
     """Id of the first room whose floor polygon contains ``xy``; failing that,
     the room whose boundary is nearest within ``snap`` metres (for objects
@@ -475,205 +421,3 @@ def room_containing(rooms: Sequence["Room"], xy, snap: float = 0.0) -> str | Non
             if d <= best_d:
                 best, best_d = r.id, d
     return best
-
-
-def _segments_cross(a0, a1, b0, b1) -> bool:
-    def orient(p, q, r):
-        return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
-
-    d1, d2 = orient(b0, b1, a0), orient(b0, b1, a1)
-    d3, d4 = orient(a0, a1, b0), orient(a0, a1, b1)
-    return (d1 * d2 < -1e-12) and (d3 * d4 < -1e-12)
-
-
-def polygon_problem(poly: Sequence[Sequence[float]]) -> str | None:
-    """Why a floor polygon is unusable (too few points, zero area,
-    self-intersecting, non-finite), or None when it is fine."""
-    p = np.asarray(poly, dtype=np.float64)
-    if p.ndim != 2 or p.shape[1] != 2:
-        return f"expected a list of (x, y) points, got shape {p.shape}"
-    if not np.all(np.isfinite(p)):
-        return "has NaN or infinite coordinates"
-    if len(p) >= 2 and np.allclose(p[0], p[-1]):
-        p = p[:-1]
-    if len(p) < 3:
-        return f"has {len(p)} distinct points; a polygon needs at least 3"
-    if abs(polygon_area(p)) < 1e-6:
-        return "has zero area"
-    n = len(p)
-    for i in range(n):
-        for j in range(i + 1, n):
-            if abs(i - j) in (1, n - 1):
-                continue
-            if _segments_cross(p[i], p[(i + 1) % n], p[j], p[(j + 1) % n]):
-                return f"is self-intersecting (edges {i} and {j} cross)"
-    return None
-
-
-# ---------------------------------------------------------------------------
-# Validation
-# ---------------------------------------------------------------------------
-
-
-def _finite(values: Iterable[float]) -> bool:
-    return all(math.isfinite(v) for v in values)
-
-
-def validate_scene(scene: Scene, path: str | None = None) -> Scene:
-    """Check a scene's internal consistency; raise :class:`SceneError` naming
-    the element and the reason. Returns the scene unchanged when valid.
-
-    Checks: unique ids; known room labels; usable floor polygons; finite
-    numbers everywhere; instance rooms, supports and door rooms that exist.
-    (Reachability of rooms is a property of the navigation grid and is
-    checked there, see :func:`ignjax.scenes.navgrid.check_reachable`.)
-    """
-    src = path or scene.meta.source
-    if not scene.rooms:
-        raise SceneError(src, "rooms", "the scene has no rooms")
-    seen: set[str] = set()
-    for i, r in enumerate(scene.rooms):
-        where = f"rooms[{i}] ({r.id})"
-        if r.id in seen:
-            raise SceneError(src, where, f"duplicate room id {r.id!r}")
-        seen.add(r.id)
-        if r.label not in vocab.ALL_ROOM_LABELS:
-            raise SceneError(src, where, f"room label {r.label!r} is not one of {vocab.ALL_ROOM_LABELS}")
-        problem = polygon_problem(r.polygon)
-        if problem:
-            raise SceneError(src, f"{where}.polygon", f"floor polygon {problem}")
-    room_ids = {r.id for r in scene.rooms}
-    for i, d in enumerate(scene.doors):
-        where = f"doors[{i}] ({d.id})"
-        if not _finite(d.position + (d.width, d.yaw, d.height)):
-            raise SceneError(src, where, "has NaN or infinite values")
-        if d.width <= 0:
-            raise SceneError(src, where, f"door width must be positive, got {d.width}")
-        for rid in d.rooms:
-            if rid is not None and rid not in room_ids:
-                raise SceneError(src, where, f"door refers to unknown room {rid!r}")
-    for i, w in enumerate(scene.walls):
-        if not _finite(w.start + w.end + (w.thickness, w.height, w.bottom)):
-            raise SceneError(src, f"walls[{i}] ({w.id})", "has NaN or infinite values")
-    ids: set[str] = set()
-    for i, inst in enumerate(scene.instances):
-        where = f"instances[{i}] ({inst.id})"
-        if inst.id in ids:
-            raise SceneError(src, where, f"duplicate instance id {inst.id!r}")
-        ids.add(inst.id)
-        nums = inst.position + (inst.yaw,) + inst.bbox.center + inst.bbox.half_extents + (inst.bbox.yaw,)
-        if not _finite(nums):
-            raise SceneError(src, where, "position or bounding box has NaN or infinite values")
-        if any(h < 0 for h in inst.bbox.half_extents):
-            raise SceneError(src, where, "bounding box has negative extent")
-        if inst.room is not None and inst.room not in room_ids:
-            raise SceneError(src, where, f"instance refers to unknown room {inst.room!r}")
-        for g in inst.geoms:
-            if g.kind not in GEOM_KINDS:
-                raise SceneError(src, where, f"unknown geom kind {g.kind!r}")
-            if not _finite(g.size + g.pos + g.quat):
-                raise SceneError(src, where, f"geom {g.part or g.kind} has NaN or infinite values")
-            if g.kind == "mesh" and (g.mesh is None or len(g.mesh.faces) == 0):
-                raise SceneError(src, where, "mesh geom has no triangles")
-            if g.kind == "mesh" and not np.all(np.isfinite(g.mesh.vertices)):
-                raise SceneError(src, where, "mesh has NaN or infinite vertices")
-    for i, inst in enumerate(scene.instances):
-        if inst.support is not None and inst.support not in ids:
-            raise SceneError(src, f"instances[{i}] ({inst.id})", f"support refers to unknown instance {inst.support!r}")
-    return scene
-
-
-# ---------------------------------------------------------------------------
-# JSON (de)serialisation: lossless, for caches, tests and debugging
-# ---------------------------------------------------------------------------
-
-SCENE_JSON_VERSION = 1
-
-
-def _geom_to_dict(g: Geom) -> dict[str, Any]:
-    d: dict[str, Any] = {"kind": g.kind, "size": list(g.size), "pos": list(g.pos), "quat": list(g.quat),
-                         "rgba": list(g.rgba), "part": g.part, "material": g.material}
-    if g.mesh is not None:
-        d["mesh"] = {"vertices": g.mesh.vertices.tolist(), "faces": g.mesh.faces.tolist()}
-    return d
-
-
-def _geom_from_dict(d: dict[str, Any]) -> Geom:
-    mesh = d.get("mesh")
-    return Geom(kind=d["kind"], size=d["size"], pos=d["pos"], quat=d["quat"], rgba=d["rgba"],
-                part=d.get("part", ""), material=d.get("material"),
-                mesh=MeshData(np.array(mesh["vertices"]), np.array(mesh["faces"])) if mesh else None)
-
-
-def scene_to_dict(scene: Scene) -> dict[str, Any]:
-    """Lossless JSON-ready dict of a scene."""
-    return {
-        "format": "ignjax-scene",
-        "version": SCENE_JSON_VERSION,
-        "id": scene.id,
-        "wall_height": scene.wall_height,
-        "meta": dataclasses.asdict(scene.meta),
-        "rooms": [{"id": r.id, "label": r.label, "polygon": [list(p) for p in r.polygon], "name": r.name} for r in scene.rooms],
-        "doors": [{"id": d.id, "position": list(d.position), "width": d.width, "yaw": d.yaw, "rooms": list(d.rooms),
-                   "height": d.height, "kind": d.kind} for d in scene.doors],
-        "walls": [{"id": w.id, "start": list(w.start), "end": list(w.end), "thickness": w.thickness, "height": w.height,
-                   "bottom": w.bottom, "rooms": list(w.rooms)} for w in scene.walls],
-        "instances": [
-            {"id": i.id, "category": i.category, "position": list(i.position), "yaw": i.yaw,
-             "bbox": {"center": list(i.bbox.center), "half_extents": list(i.bbox.half_extents), "yaw": i.bbox.yaw},
-             "room": i.room, "attributes": i.attributes.as_dict(), "support": i.support, "structural": i.structural,
-             "geoms": [_geom_to_dict(g) for g in i.geoms], "name": i.name}
-            for i in scene.instances
-        ],
-    }
-
-
-def scene_from_dict(d: dict[str, Any], path: str | None = None) -> Scene:
-    """Inverse of :func:`scene_to_dict`; raises :class:`SceneError` on bad input."""
-    if d.get("format") != "ignjax-scene":
-        raise SceneError(path, "format", "not an ignjax scene document (expected format 'ignjax-scene')")
-    if d.get("version") != SCENE_JSON_VERSION:
-        raise SceneError(path, "version", f"unsupported scene version {d.get('version')!r}; this ignjax reads {SCENE_JSON_VERSION}")
-    try:
-        scene = Scene(
-            id=d["id"],
-            wall_height=d.get("wall_height", 2.5),
-            meta=SceneMeta(**d.get("meta", {})),
-            rooms=tuple(Room(r["id"], r["label"], tuple(tuple(p) for p in r["polygon"]), r.get("name", "")) for r in d["rooms"]),
-            doors=tuple(Door(x["id"], x["position"], x["width"], x["yaw"], tuple(x["rooms"]), x.get("height", 2.1), x.get("kind", "door")) for x in d.get("doors", [])),
-            walls=tuple(Wall(x["id"], x["start"], x["end"], x["thickness"], x["height"], x.get("bottom", 0.0), tuple(x.get("rooms", ()))) for x in d.get("walls", [])),
-            instances=tuple(
-                Instance(id=x["id"], category=x["category"], position=x["position"], yaw=x["yaw"],
-                         bbox=OrientedBox(**x["bbox"]), room=x.get("room"), attributes=Attributes(**x.get("attributes", {})),
-                         support=x.get("support"), structural=x.get("structural", False),
-                         geoms=tuple(_geom_from_dict(g) for g in x.get("geoms", [])), name=x.get("name", ""))
-                for x in d.get("instances", [])
-            ),
-        )
-    except (KeyError, TypeError, ValueError) as e:
-        raise SceneError(path, None, f"malformed scene document: {e!r}") from e
-    return validate_scene(scene, path)
-
-
-def scene_to_json(scene: Scene) -> str:
-    return json.dumps(scene_to_dict(scene), separators=(",", ":"))
-
-
-def scene_summary(scene: Scene) -> dict[str, Any]:
-    """The ``inspect --json`` summary: source, units, rooms and instances.
-
-    Positions are metres in the Z-up frame (the instance's ``position``).
-    Structural instances are left out of ``instances``.
-    """
-    return {
-        "source": scene.meta.source,
-        "scene_id": scene.id,
-        "format": scene.meta.source_format,
-        "up_axis": scene.meta.up_axis,
-        "meters_per_unit": scene.meta.meters_per_unit,
-        "rooms": [{"id": r.id, "label": r.label} for r in scene.rooms],
-        "instances": [
-            {"id": i.id, "category": i.category, "room": i.room, "position": [round(v, 6) for v in i.position]}
-            for i in scene.objects
-        ],
-    }
