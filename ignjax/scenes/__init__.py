@@ -5,8 +5,8 @@
 * :mod:`~ignjax.scenes.graph`: the derived room-object graph.
 * :mod:`ignjax.scenes.io`: read any supported source (:func:`~ignjax.scenes.io.sources.load_scenes`,
   a registry of readers by suffix): USD (import and export), ProcTHOR, glTF/GLB/OBJ, manifests.
-* :mod:`ignjax.scenes.procgen`: procedural houses (params, layout, furnish, generate) and the
-  object catalogue.
+* :mod:`ignjax.scenes.procgen`: procedural houses (params, layout, furnish with roomspace,
+  placement, companions and distractors, generate) and the object catalogue.
 * :mod:`~ignjax.scenes.compile`: MuJoCo/MJX models; :mod:`~ignjax.scenes.voxels`,
   :mod:`~ignjax.scenes.navgrid`, :mod:`~ignjax.scenes.geodesic`, :mod:`~ignjax.scenes.raygrid`:
   voxels, navigation grids, geodesic fields, the ray caster's arrays;

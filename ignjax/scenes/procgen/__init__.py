@@ -5,7 +5,13 @@
 * :mod:`~ignjax.scenes.procgen.params`: :class:`HouseParams` and its checks.
 * :mod:`~ignjax.scenes.procgen.layout`: room program, rectangle layout,
   adjacency, doors and walls.
-* :mod:`~ignjax.scenes.procgen.furnish`: the furnisher and the distractor plan.
+* :mod:`~ignjax.scenes.procgen.furnish`: :func:`furnish`, each room furnished
+  in order (its docstring gives the rules).
+* :mod:`~ignjax.scenes.procgen.roomspace`: the room being furnished, box
+  geometry and the navigability check.
+* :mod:`~ignjax.scenes.procgen.placement`: the placement rules (the furnisher).
+* :mod:`~ignjax.scenes.procgen.companions`: tables and the seats facing them.
+* :mod:`~ignjax.scenes.procgen.distractors`: the per-house distractor plan.
 * :mod:`~ignjax.scenes.procgen.catalogue`: the object categories and their
   builders.
 """
