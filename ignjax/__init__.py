@@ -47,7 +47,7 @@ _EXPORTS = {
     "load_benchmark": "ignjax.episodes.dataset",
     "EpisodeSet": "ignjax.episodes.dataset",
     "make_world": "ignjax.evaluate.runner",
-    "SimConfig": "ignjax.sim.types",
+    "SimConfig": "ignjax.sim.simconfig",
     "reset": "ignjax.sim.env",
     "step": "ignjax.sim.env",
     "observe": "ignjax.sim.env",

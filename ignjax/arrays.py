@@ -1,5 +1,6 @@
 """Array helpers shared by every layer: the one pytree-dataclass decorator,
-the numpy / jax.numpy dispatch of functions that accept either, and numeric
+the numpy / jax.numpy dispatch of functions that accept either, functions
+over whole pytrees (select, host copy, a batch of one and back) and numeric
 vectors parsed from command-line text."""
 
 from __future__ import annotations
@@ -66,6 +67,30 @@ def on_device(x, dtype=None) -> jax.Array:
     looked up in the compilation cache, which adds up when a benchmark's
     tables are loaded."""
     return jax.device_put(np.asarray(x, dtype))
+
+
+def tree_select(pred, on_true, on_false):
+    """Elementwise ``where`` over two pytrees of the same structure; ``pred``
+    selects along the leading axes (a () pred a whole tree, a (B,) pred rows
+    of a batch)."""
+    pred = jnp.asarray(pred)
+    return jax.tree.map(lambda a, b: jnp.where(pred.reshape(pred.shape + (1,) * (jnp.ndim(a) - pred.ndim)), a, b),
+                        on_true, on_false)
+
+
+def numpy_tree(tree):
+    """A pytree of device arrays as numpy arrays (host copy)."""
+    return jax.tree.map(lambda a: np.asarray(a), tree)
+
+
+def batch_of_one(tree):
+    """A pytree with a leading batch axis of size 1 added to every leaf."""
+    return jax.tree.map(lambda x: x[None], tree)
+
+
+def only_row(tree):
+    """Row 0 of a pytree with a leading batch axis (the inverse of :func:`batch_of_one`)."""
+    return jax.tree.map(lambda x: x[0], tree)
 
 
 def parse_floats(text, n: int, where: str) -> tuple[float, ...]:
@@ -136,4 +161,5 @@ def field_docs(cls: type) -> dict[str, str]:
     return docs
 
 
-__all__ = ["field_docs", "on_device", "parse_assignment", "parse_floats", "pytree_dataclass", "xp"]
+__all__ = ["batch_of_one", "field_docs", "numpy_tree", "on_device", "only_row", "parse_assignment", "parse_floats",
+           "pytree_dataclass", "tree_select", "xp"]

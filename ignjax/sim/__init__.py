@@ -1,8 +1,10 @@
 """The simulator: the paper's protocol as pure JAX functions for one episode,
 and the rollouts that batch them.
 
-* :mod:`~ignjax.sim.types`: configuration (:class:`SimConfig`), state, actions,
-  observations, answers, outcomes (every pytree the simulator passes).
+* :mod:`~ignjax.sim.types`: the codes, state, actions, observations, answers (the
+  pytrees of each step), re-exporting :mod:`~ignjax.sim.simconfig`'s configuration
+  (:class:`~ignjax.sim.simconfig.SimConfig`) and :mod:`~ignjax.sim.records`' outcomes,
+  trajectories and privileged information: every pytree the simulator passes.
 * :mod:`~ignjax.sim.world`: the :class:`World` every episode shares (scene bank,
   goal fields, probe map).
 * :mod:`~ignjax.sim.env`: ``reset`` / ``step`` / ``observe`` / ``outcome``, built from

@@ -1,11 +1,18 @@
-"""Core simulator pytrees: configuration, state, actions, observations, answers.
+"""Core simulator pytrees: the codes, and what passes between agent and
+simulator at each step (actions, observations, answers) with the episode's
+fixed facts and state.
 
 Every array field documents its shape and dtype for ONE episode; under
 ``vmap`` a leading batch axis is added. All pytrees are frozen dataclasses
 registered by :func:`ignjax.arrays.pytree_dataclass`; change them with
-:func:`dataclasses.replace`. The rollout's records (:class:`OutcomeRow`,
-:class:`Trajectory`) and what privileged agents receive (:class:`Privileged`)
-live here too.
+:func:`dataclasses.replace`.
+
+This module is also the simulator's one import for its types: it re-exports
+the configuration (:class:`~ignjax.sim.simconfig.SimConfig`), the rollout's
+records and what privileged agents receive (:class:`~ignjax.sim.records.OutcomeRow`,
+:class:`~ignjax.sim.records.Trajectory`, :class:`~ignjax.sim.records.Privileged`)
+and the pytree helpers of :mod:`ignjax.arrays` (``tree_select``,
+``numpy_tree``, ``batch_of_one``, ``only_row``).
 
 Codes
     Action kinds: ``MOVE = 0``, ``ASK = 1``, ``STOP = 2``.
@@ -21,17 +28,13 @@ Codes
 
 from __future__ import annotations
 
-import dataclasses
-import math
-from dataclasses import dataclass
-
 import jax
 import jax.numpy as jnp
-import numpy as np
 
 from ignjax import protocol
-from ignjax.arrays import pytree_dataclass
-from ignjax.errors import ConfigError
+from ignjax.arrays import batch_of_one, numpy_tree, only_row, pytree_dataclass, tree_select
+from ignjax.sim.records import OutcomeRow, Privileged, Trajectory
+from ignjax.sim.simconfig import SimConfig
 
 MOVE, ASK, STOP = 0, 1, 2
 ACTION_KINDS = ("move", "ask", "stop")
@@ -49,162 +52,6 @@ front within range), ``NO_CANDIDATE`` is a question that pointed at no
 object (the answer is no: :mod:`ignjax.evaluate.candidates`)."""
 N_VIEWS = protocol.N_VIEWS
 N_QTYPES = protocol.N_QUESTION_TYPES
-
-
-@dataclass(frozen=True)
-class SimConfig:
-    """Static simulator configuration (hashable; shapes and limits).
-
-    Attributes:
-        max_steps: planner steps per episode (an ASK is a step); paper: 20.
-        max_questions: questions charged per episode; paper: 10.
-        horizon: longest waypoint a MOVE may command, metres; default 3.
-        collision_distance: forward rays stop motion at this range, m; 0.6.
-        collision_heights: heights of the forward collision rays, m.
-        micro_step: longest single motion of the local controller, m.
-        max_micro_steps: micro-steps per MOVE.
-        eye_height: camera height, m.
-        image_size: (W, H) of a view, pixels (for the grid-to-pixel map).
-        hfov: horizontal field of view of each of the 8 views, degrees
-            (the paper's 90: neighbours overlap by half). 4 and 12 views
-            tile the circle instead, 360 / n_views degrees each
-            (``view_hfov``), so with them this must stay 90. The symbolic observation's 8 sectors are this wide
-            whatever ``n_views`` is.
-        n_views: views of the egocentric panel (4, 8 or 12); a MOVE's
-            ``direction`` k means view k, along ``heading + k * 360 / n_views``
-            degrees (counter-clockwise), ``view_hfov`` degrees wide (90 with
-            4 and 8 views, 30 with 12). The paper's
-            agents use 8; 4 and 12 are its observation ablation. The
-            symbolic observation keeps its 8 sectors whatever this is, and
-            the built-in JAX agents plan with 8 views
-            (:func:`ignjax.evaluate.runner.run_agent` refuses another value
-            for them).
-        depth_range: longest valid depth of a pixel ray, m.
-        pullback: distance the waypoint is pulled back from a hit surface, m.
-        waypoint_tolerance: a waypoint closer than this is reached, m.
-        hint_lookahead: Type-3 hints look this far along the shortest path, m; 4.
-        confirm_range: Type-4 says yes only within this distance, m; 3.
-        stop_radius: a confirmed target this close means "stop now", m.
-        hint_reached: the hinted point counts as reached within this, m.
-        obs_rays_per_view: free-space rays per view in the observation.
-        obs_range: range of observation rays and of visibility, m.
-        max_visible: visible-instance slots in the observation.
-        trace_len: question-trace slots (attempts, charged or refused); 0
-            (default): ``max_steps``, one per possible attempt (:attr:`trace_slots`).
-        question_budget: questions beyond ``max_questions`` are refused; false:
-            no question is ever refused (an unbudgeted protocol, as the
-            paper's naive rows read; docs/protocol.md, "Reading the paper's tables").
-        upfront_description: the agent receives the target's full
-            description (the Type-1 and Type-2 facts) at reset, charged as one
-            Type-1 and one Type-2 question (counted in ``n_questions`` and
-            the budget, not in the question trace).
-        miss_rate: noisy perception: probability that an instance in sight is
-            missed, at 3 m for an object 0.5 m across; it grows linearly with
-            distance and shrinks with size (clipped to [0, 1]). 0: perfect.
-        confusion_rate: noisy perception: probability that each perceived
-            attribute (colour, material, size, state) is replaced by another
-            value, scaled like ``miss_rate``. 0: perfect.
-    """
-
-    max_steps: int = protocol.MAX_STEPS
-    max_questions: int = protocol.MAX_QUESTIONS
-    horizon: float = 3.0
-    collision_distance: float = protocol.COLLISION_DISTANCE
-    collision_heights: tuple[float, ...] = (0.15, 0.6, 1.2)
-    micro_step: float = 0.5
-    max_micro_steps: int = 8
-    eye_height: float = 1.25
-    image_size: tuple[int, int] = (640, 640)
-    hfov: float = 90.0
-    n_views: int = N_VIEWS
-    depth_range: float = 10.0
-    pullback: float = 0.3
-    waypoint_tolerance: float = 0.1
-    hint_lookahead: float = protocol.HINT_LOOKAHEAD
-    confirm_range: float = protocol.CONFIRM_RANGE
-    stop_radius: float = 1.0
-    hint_reached: float = 1.0
-    obs_rays_per_view: int = 3
-    obs_range: float = 6.0
-    max_visible: int = 16
-    trace_len: int = 0
-    question_budget: bool = True
-    upfront_description: bool = False
-    miss_rate: float = 0.0
-    confusion_rate: float = 0.0
-
-    def __post_init__(self):
-        if isinstance(self.trace_len, bool) or not isinstance(self.trace_len, int) or self.trace_len < 0:
-            raise ConfigError(None, "sim.trace_len", f"must be 0 (max_steps) or a positive integer, got {self.trace_len!r}")
-        for name in ("max_steps", "max_questions", "max_micro_steps", "obs_rays_per_view", "max_visible"):
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
-                raise ConfigError(None, f"sim.{name}", f"must be a positive integer, got {v!r}")
-        for name in ("horizon", "collision_distance", "micro_step", "eye_height", "hfov", "depth_range",
-                     "hint_lookahead", "confirm_range", "stop_radius", "hint_reached", "obs_range"):
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0:
-                raise ConfigError(None, f"sim.{name}", f"must be a positive number, got {v!r}")
-        for name in ("question_budget", "upfront_description"):
-            if not isinstance(getattr(self, name), bool):
-                raise ConfigError(None, f"sim.{name}", f"must be true or false, got {getattr(self, name)!r}")
-        for name in ("miss_rate", "confusion_rate"):
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 <= v <= 1:
-                raise ConfigError(None, f"sim.{name}", f"must be a probability in [0, 1], got {v!r}")
-        for name in ("pullback", "waypoint_tolerance"):
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0:
-                raise ConfigError(None, f"sim.{name}", f"must be a non-negative number, got {v!r}")
-        heights = self.collision_heights
-        if not isinstance(heights, (list, tuple)) or not heights or any(
-                isinstance(h, bool) or not isinstance(h, (int, float)) or not math.isfinite(h) or h <= 0 for h in heights):
-            raise ConfigError(None, "sim.collision_heights", f"must be a list of positive heights, got {heights!r}")
-        size = self.image_size
-        if not isinstance(size, (list, tuple)) or len(size) != 2 or any(
-                isinstance(v, bool) or not isinstance(v, int) or v < 8 for v in size):
-            raise ConfigError(None, "sim.image_size", f"must be [width, height] in pixels (>= 8), got {size!r}")
-        if not 0 < self.hfov < 180:
-            raise ConfigError(None, "sim.hfov", f"must lie in (0, 180) degrees, got {self.hfov}")
-        if isinstance(self.n_views, bool) or self.n_views not in protocol.VIEW_COUNTS:
-            raise ConfigError(None, "sim.n_views", f"must be 4, 8 or 12 views, got {self.n_views!r}")
-        if self.n_views != N_VIEWS and self.hfov != protocol.VIEW_HFOV:
-            raise ConfigError(None, "sim.hfov", f"sets the width of each of the 8 views; {self.n_views} views tile the "
-                              f"circle ({360 / self.n_views:g} degrees each), so it must stay {protocol.VIEW_HFOV:g} "
-                              f"with them, got {self.hfov}")
-        if 0 < self.trace_len < self.max_steps:
-            raise ConfigError(None, "sim.trace_len", f"must be >= max_steps ({self.max_steps}) to hold every question attempt")
-        object.__setattr__(self, "collision_heights", tuple(float(h) for h in self.collision_heights))
-        object.__setattr__(self, "image_size", tuple(int(v) for v in self.image_size))
-
-    @classmethod
-    def from_values(cls, values: dict, where: str | None = None) -> "SimConfig":
-        """A configuration from ``field -> value`` (e.g. ``--set sim.*`` items);
-        an unknown field is an error naming it and the known ones."""
-        known = [f.name for f in dataclasses.fields(cls)]
-        for key in values:
-            if key not in known:
-                raise ConfigError(where, f"sim.{key}", f"unknown key; known: {', '.join(known)}")
-        return cls(**values)
-
-    def to_dict(self) -> dict:
-        """``field -> value`` (lists for tuples), as run.json records it."""
-        return {f.name: list(v) if isinstance(v := getattr(self, f.name), tuple) else v for f in dataclasses.fields(self)}
-
-    @property
-    def view_hfov(self) -> float:
-        """Horizontal field of view of each view of the panel, degrees
-        (:func:`ignjax.protocol.view_hfov`): ``hfov`` for 8 views, 360 / n for
-        4 and 12 (views that tile the circle). The renderers' cameras, the
-        executor's back-projection of a grid cell and the oracle's "in the
-        front view" test all use it."""
-        return protocol.view_hfov(self.n_views, self.hfov)
-
-    @property
-    def trace_slots(self) -> int:
-        """Slots of the question trace: ``trace_len``, or ``max_steps`` when it is 0."""
-        return self.trace_len or self.max_steps
-
 
 
 @pytree_dataclass
@@ -492,184 +339,11 @@ class SimState:
     answers: Answer
 
 
-@pytree_dataclass
-class OutcomeRow:
-    """One episode's outcome (arrays; a leading batch axis under vmap).
-
-    Attributes:
-        final_distance: () float32 geodesic distance to the target at the end.
-        final_euclidean: () float32 2-D distance to the target footprint.
-        min_distance: () float32 smallest geodesic distance along the path.
-        path_length: () float32 metres travelled.
-        steps: () int32 planner steps used.
-        stopped: () bool, ended by STOP.
-        stop_reason: () int32 (see the module docstring).
-        n_questions: (4,) int32 charged questions per type.
-        n_refused: () int32 refused questions.
-        n_invalid: () int32 clamped out-of-range actions.
-        trace_type, trace_step, trace_charged: (T,) the question trace.
-        difficulty: () int32 bin.
-        valid: () bool.
-    """
-
-    final_distance: jax.Array
-    final_euclidean: jax.Array
-    min_distance: jax.Array
-    path_length: jax.Array
-    steps: jax.Array
-    stopped: jax.Array
-    stop_reason: jax.Array
-    n_questions: jax.Array
-    n_refused: jax.Array
-    n_invalid: jax.Array
-    trace_type: jax.Array
-    trace_step: jax.Array
-    trace_charged: jax.Array
-    difficulty: jax.Array
-    valid: jax.Array
-
-    METRIC_FIELDS = ("final_distance", "min_distance", "path_length", "stopped", "n_questions", "difficulty")
-    """The columns every metric needs (:mod:`ignjax.evaluate.metrics`)."""
-
-    @staticmethod
-    def from_numpy(**columns) -> "OutcomeRow":
-        """Outcomes of many episodes from numpy columns (any leading shape).
-
-        The :attr:`METRIC_FIELDS` are required; ``valid`` defaults to all
-        True; other fields not given are zeros (``final_euclidean`` the
-        final distance, question traces of length 0).
-        """
-        missing = [k for k in OutcomeRow.METRIC_FIELDS if k not in columns]
-        if missing:
-            raise TypeError(f"OutcomeRow.from_numpy: missing columns {missing}")
-        shape = np.shape(columns["final_distance"])
-        defaults = {"final_euclidean": columns["final_distance"], "valid": np.ones(shape, bool),
-                    "steps": np.zeros(shape, np.int32), "stop_reason": np.zeros(shape, np.int32),
-                    "n_refused": np.zeros(shape, np.int32), "n_invalid": np.zeros(shape, np.int32),
-                    "trace_type": np.zeros(shape + (0,), np.int32), "trace_step": np.zeros(shape + (0,), np.int32),
-                    "trace_charged": np.zeros(shape + (0,), bool)}
-        unknown = set(columns) - {f.name for f in dataclasses.fields(OutcomeRow)}
-        if unknown:
-            raise TypeError(f"OutcomeRow.from_numpy: unknown columns {sorted(unknown)}")
-        return OutcomeRow(**{f.name: np.asarray(columns[f.name] if f.name in columns else defaults[f.name])
-                             for f in dataclasses.fields(OutcomeRow)})
-
-
-@pytree_dataclass
-class Trajectory:
-    """Per-step record of one episode: what the agent decided on, what it
-    decided, and what the simulator answered (what the episode viewer,
-    :mod:`ignjax.view`, replays and the trajectory plots and interaction
-    analyses read).
-
-    S is ``max_steps``; the steps after the episode ended have ``kind ==
-    -1`` (their other entries are the fill values below or repeat the final
-    state). Everything the viewer
-    words (the oracle's answers through :mod:`ignjax.sim.oracle_text`) is
-    kept as the simulator's codes, not text, so the record stays a few
-    hundred bytes per episode and step.
-
-    Attributes:
-        pose: (S + 1, 3) float32 pose before the first step and after each step.
-        kind: (S,) int32 action kind of each step (-1 after the episode ended).
-        question: (S,) int32 question type of ASK steps, 0 otherwise.
-        direction, col, row: (S,) int32 the MOVE's view (0..7) and grid
-            cell (column and row 1..8), as executed (clamped into range);
-            -1 for other steps.
-        candidate: (S,) int32 the instance handle a Type-4 question asked
-            about (-1: "what is in front of me", and for other steps; -2: the
-            question pointed at no object).
-        waypoint: (S, 2) float32 the executor's waypoint of a MOVE (world);
-            the pose before the step for other steps.
-        blocked: (S, 8) bool headings (relative to the yaw before the MOVE,
-            view layout) found blocked during a MOVE; False for other steps.
-        refused: (S,) bool the step's question was refused (budget spent).
-        n_questions: (S, 4) int32 charged questions per type after the step
-            (the running cost discount; with ``upfront_description`` it
-            starts at one Type-1 and one Type-2).
-        confirm, follow_up: (S,) int32 the Type-4 answer and follow-up
-            state after the step (:class:`Answer` codes).
-        hint_room_label, hint_sector, hint_landmark: (S,) int32 the Type-3
-            answer's facts after the step.
-        hint_in_room: (S,) bool the Type-3 route stays in the room.
-        hint_progress: (S,) int32 the active hint's progress code after the step.
-        room_label: (S,) int32 the room label the agent perceived when it
-            decided (the observation before the step).
-        visible: (S, K) int32 handles of the instances in sight when it
-            decided (the scene's instance index; -1 empty), K = ``max_visible``.
-        visible_attrs: (S, K, 4) int8 their perceived colour, material,
-            size and state codes (differ from the scene's under perception
-            noise; -1 unknown).
-    """
-
-    pose: jax.Array
-    kind: jax.Array
-    question: jax.Array
-    direction: jax.Array
-    col: jax.Array
-    row: jax.Array
-    candidate: jax.Array
-    waypoint: jax.Array
-    blocked: jax.Array
-    refused: jax.Array
-    n_questions: jax.Array
-    confirm: jax.Array
-    follow_up: jax.Array
-    hint_room_label: jax.Array
-    hint_sector: jax.Array
-    hint_landmark: jax.Array
-    hint_in_room: jax.Array
-    hint_progress: jax.Array
-    room_label: jax.Array
-    visible: jax.Array
-    visible_attrs: jax.Array
-
-    STEP_FIELDS = ("kind", "question", "direction", "col", "row", "candidate", "waypoint", "blocked", "refused",
-                   "n_questions", "confirm", "follow_up", "hint_room_label", "hint_sector", "hint_landmark",
-                   "hint_in_room", "hint_progress", "room_label", "visible", "visible_attrs")
-    """The fields with one entry per step (every field but ``pose``), in
-    the order :func:`ignjax.sim.rollout.step_record` returns them."""
-
-
-@pytree_dataclass
-class Privileged:
-    """Information only privileged agents receive (:func:`ignjax.sim.env.privileged_info`).
-
-    Attributes:
-        geodesic: () float32 geodesic distance to the target now.
-        best_direction, best_col, best_row: () int32 the MOVE whose executor
-            waypoint is geodesically closest to the target, among views
-            0..7 x columns {3, 4, 5, 6} x rows {1, 2, 3}.
-        best_value: () float32 geodesic distance at that waypoint.
-    """
-
-    geodesic: jax.Array
-    best_direction: jax.Array
-    best_col: jax.Array
-    best_row: jax.Array
-    best_value: jax.Array
-
-
-def tree_select(pred, on_true, on_false):
-    """Elementwise ``where`` over two pytrees of the same structure; ``pred``
-    selects along the leading axes (a () pred a whole tree, a (B,) pred rows
-    of a batch)."""
-    pred = jnp.asarray(pred)
-    return jax.tree.map(lambda a, b: jnp.where(pred.reshape(pred.shape + (1,) * (jnp.ndim(a) - pred.ndim)), a, b),
-                        on_true, on_false)
-
-
-def numpy_tree(tree):
-    """A pytree of device arrays as numpy arrays (host copy)."""
-    return jax.tree.map(lambda a: np.asarray(a), tree)
-
-
-
-def batch_of_one(tree):
-    """A pytree with a leading batch axis of size 1 added to every leaf."""
-    return jax.tree.map(lambda x: x[None], tree)
-
-
-def only_row(tree):
-    """Row 0 of a pytree with a leading batch axis (the inverse of :func:`batch_of_one`)."""
-    return jax.tree.map(lambda x: x[0], tree)
+__all__ = [
+    "ABORTED", "ACTION_KINDS", "AGENT_FIELDS", "ANY_CANDIDATE", "ASK", "FOLLOW_NONE", "FOLLOW_ONE_MOVE",
+    "FOLLOW_STOP_NOW", "HINT_CLOSER", "HINT_FARTHER", "HINT_NONE", "HINT_PROGRESS", "HINT_REACHED", "HINT_SAME",
+    "HINT_STOP", "MOVE", "NO_CANDIDATE", "N_QTYPES", "N_VIEWS", "OUT_OF_STEPS", "RUNNING", "STOP", "STOPPED",
+    "STOP_REASONS", "Action", "Answer", "EpisodeSpec", "Observation", "SimState",
+    # re-exported from their homes
+    "SimConfig", "OutcomeRow", "Trajectory", "Privileged", "tree_select", "numpy_tree", "batch_of_one", "only_row",
+]
