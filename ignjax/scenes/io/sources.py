@@ -23,14 +23,13 @@ from pathlib import Path
 from types import MappingProxyType
 
 from ignjax.errors import SceneError, call_recording_warnings, warn_again
-from ignjax.scenes.io.formats import JSON_SUFFIXES, MESH_SUFFIXES, SIDECAR_SUFFIX, USD_SUFFIXES
+from ignjax.scenes.io.formats import MESH_SUFFIXES, SIDECAR_SUFFIX, USD_SUFFIXES
 from ignjax.scenes.io.manifest import read_manifest
 from ignjax.scenes.io.remembered import read_remembered
 from ignjax.scenes.model import Scene
 from ignjax.scenes.model.scenejson import scene_from_dict
 
 _USD_VERSION = importlib.metadata.version("usd-core")
-
 
 
 def _suffix(path: Path) -> str:
