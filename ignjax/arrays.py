@@ -93,6 +93,16 @@ def only_row(tree):
     return jax.tree.map(lambda x: x[0], tree)
 
 
+def ragged_index(counts) -> tuple[np.ndarray, np.ndarray]:
+    """``(owner, offset)`` of ``sum(counts)`` items laid out group after
+    group: item ``i`` is number ``offset[i]`` of the ``counts[owner[i]]``
+    items of group ``owner[i]`` (a ragged loop as flat arrays)."""
+    counts = np.asarray(counts, np.int64)
+    owner = np.repeat(np.arange(len(counts)), counts)
+    starts = np.cumsum(counts) - counts
+    return owner, np.arange(len(owner)) - starts[owner]
+
+
 def parse_floats(text, n: int, where: str) -> tuple[float, ...]:
     """Numbers from comma-separated text (a command-line option).
 

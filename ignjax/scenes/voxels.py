@@ -47,6 +47,7 @@ import mujoco
 import numpy as np
 from scipy import ndimage
 
+from ignjax.arrays import ragged_index
 from ignjax.scenes.model import Scene
 
 #: Columns of a row of :attr:`NavGrid.prims <ignjax.scenes.navgrid.NavGrid.prims>`.
@@ -126,12 +127,13 @@ class _Voxelizer:
         i1 = np.floor((hi - self.lo) / self.cell).astype(np.int64)
         return np.maximum(i0, 0), np.minimum(i1, self.dims - 1)
 
-    def prim_voxels(self, rows: np.ndarray, chunk: int = 1 << 19):
+    def prim_voxels(self, rows: np.ndarray, ext: np.ndarray, chunk: int = 1 << 19):
         """Voxels overlapping each primitive's oriented bounding box
         (separating-axis test), many primitives at a time.
 
         Args:
             rows: (P, 18) primitives (:data:`PRIM_COLUMNS`).
+            ext: (P, 3) half extents of their bounding boxes grown by :data:`_TOUCH` (:func:`_extents`).
             chunk: about how many candidate voxels one yielded piece covers.
 
         Yields:
@@ -144,7 +146,7 @@ class _Voxelizer:
             occupancy and navigation use). A primitive's voxels all come in
             one piece.
         """
-        boxes = [_box_params(self, r, p) for p, r in enumerate(rows)]
+        boxes = [_box_params(self, r, e, p) for p, (r, e) in enumerate(zip(rows, ext))]
         for upright in (True, False):
             sel = [p for p, b in enumerate(boxes) if b is not None and b.upright == upright]
             size = [int(np.prod(boxes[p].i1 - boxes[p].i0 + 1)) for p in sel]
@@ -165,7 +167,7 @@ class _Voxelizer:
         """:meth:`prim_voxels` of upright boxes: 2-D separating axes in xy, exact z intervals."""
         i0 = np.stack([b.i0 for b in part])
         n = np.stack([b.i1 for b in part]) - i0 + 1
-        owner, off = _ragged(n[:, 0] * n[:, 1])
+        owner, off = ragged_index(n[:, 0] * n[:, 1])
         xs = i0[owner, 0] + off % n[owner, 0]
         ys = i0[owner, 1] + off // n[owner, 0]
         cx = np.array([b.center[0] for b in part])[owner]
@@ -180,7 +182,7 @@ class _Voxelizer:
             sep = np.abs(dx * ax[:, a, 0] + dy * ax[:, a, 1]) - vterm[:, a]
             ok &= sep <= thr[:, a]
         owner, xs, ys = owner[ok], xs[ok], ys[ok]
-        cell, zoff = _ragged(n[owner, 2])
+        cell, zoff = ragged_index(n[owner, 2])
         zs = i0[owner[cell], 2] + zoff
         zc = self._centres(zs, 2)
         cz = np.array([b.center[2] for b in part])
@@ -194,7 +196,7 @@ class _Voxelizer:
         """:meth:`prim_voxels` of other boxes: the 15 separating axes in 3-D."""
         i0 = np.stack([b.i0 for b in part])
         n = np.stack([b.i1 for b in part]) - i0 + 1
-        owner, off = _ragged(n.prod(1))
+        owner, off = ragged_index(n.prod(1))
         nyz = n[owner, 1] * n[owner, 2]
         idx = np.stack([i0[owner, 0] + off // nyz, i0[owner, 1] + (off // n[owner, 2]) % n[owner, 1],
                         i0[owner, 2] + off % n[owner, 2]], -1)
@@ -276,12 +278,11 @@ class _Box:
     __slots__ = ("pid", "center", "i0", "i1", "upright", "axes", "vterm", "thr", "thr_s", "zlim")
 
 
-def _box_params(vz: _Voxelizer, row: np.ndarray, pid: int) -> "_Box | None":
+def _box_params(vz: _Voxelizer, row: np.ndarray, ext: np.ndarray, pid: int) -> "_Box | None":
     """The separating-axis test's per-primitive terms (None: no voxel in range)."""
     center, rot, half = row[0:3], row[3:12].reshape(3, 3), row[12:15]
     grown = half + _TOUCH
     shrunk = np.maximum(half - _SHRINK, 0.0)
-    ext = np.abs(rot) @ grown
     i0, i1 = vz._range(center - ext, center + ext)
     if np.any(i1 < i0):
         return None
@@ -313,15 +314,6 @@ def _extents(rows: np.ndarray, grow: float) -> np.ndarray:
     """(P, 3) half extents of the primitives' axis-aligned bounding boxes, grown by ``grow``."""
     return np.stack([np.abs(r[3:12].reshape(3, 3)) @ (r[12:15] + grow) for r in rows]) if len(rows) else \
         np.zeros((0, 3))
-
-
-def _ragged(counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(owner, offset)`` of ``sum(counts)`` items: item ``i`` is number
-    ``offset[i]`` of the ``counts[owner[i]]`` items of ``owner[i]``."""
-    counts = np.asarray(counts, np.int64)
-    owner = np.repeat(np.arange(len(counts)), counts)
-    starts = np.cumsum(counts) - counts
-    return owner, np.arange(len(owner)) - starts[owner]
 
 
 def _mesh_world(model: mujoco.MjModel, data: mujoco.MjData, geom: int) -> tuple[np.ndarray, np.ndarray]:
@@ -450,7 +442,7 @@ def voxelize(compiled, config, origin, shape, n_slices):
     rows = np.stack(prims) if prims else np.zeros((0, N_PRIM_COLUMNS))
     ext = _extents(rows, _TOUCH)
     n_prims = max(len(rows), 1)
-    for vox, strict, pid in vz.prim_voxels(rows):
+    for vox, strict, pid in vz.prim_voxels(rows, ext):
         at = (vox[:, 2], vox[:, 1], vox[:, 0])
         occ_ray[at] = True
         qlo, qhi = vz.sub_boxes(vox, rows[pid, 0:3], ext[pid])

@@ -19,7 +19,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ignjax.arrays import on_device, pytree_dataclass
+from ignjax.arrays import on_device, pytree_dataclass, ragged_index
 from ignjax.cache import array_digest, code_digest, derived_store, digest
 from ignjax.devices import available_cores
 from ignjax.errors import ConfigError
@@ -166,8 +166,8 @@ def _scene_probe_bits(si: int, t: dict, origin: np.ndarray, resolution: float, s
                 cnt = seg_count[si, pr, pc, band].astype(np.int64)
                 rough = approx[si, pr, pc, band]
                 # one row per (cell, listed primitive) pair, not cells x the longest list
-                owner = np.repeat(np.arange(len(pr)), cnt)
-                ids = seg_prims[si, st[owner] + (np.arange(len(owner)) - (np.cumsum(cnt) - cnt)[owner])]
+                owner, k = ragged_index(cnt)
+                ids = seg_prims[si, st[owner] + k]
                 owner, ids = owner[ids >= 0], ids[ids >= 0]
                 rows_p = prims[si][:, ids].T[:, None, :]  # (pairs, 1, 18)
                 pts = np.stack([x[part][owner], y[part][owner], np.full(len(owner), h)], 1)
