@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import hashlib
 import os
+import threading
 from pathlib import Path
 
-_TMP = ".tmp-"  # between a file's name and the writing process's id
+_TMP = ".tmp-"  # between a file's name and the writing process's and thread's ids
 
 
 def atomic_write(path: str | os.PathLike, data: bytes | str) -> Path:
@@ -14,7 +15,7 @@ def atomic_write(path: str | os.PathLike, data: bytes | str) -> Path:
     folder, then rename it over ``path``; the folder is created if needed."""
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
-    tmp = p.with_name(f".{p.name}{_TMP}{os.getpid()}")
+    tmp = p.with_name(f".{p.name}{_TMP}{os.getpid()}-{threading.get_ident()}")
     try:
         tmp.write_bytes(data.encode("utf-8") if isinstance(data, str) else data)
         os.replace(tmp, p)

@@ -11,6 +11,7 @@ import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 from ignjax.scenes.viz.mapplot import FAMILY_NAMES, category_family, plot_scene_map, save_figure
+from ignjax.studies import cost_figures as CF
 from ignjax.studies import cost_sensitivity as CS
 from ignjax.studies import interaction_plots as IP
 from ignjax.studies import locations as LOC
@@ -163,7 +164,7 @@ def test_marginal_wsr_zooms_on_the_asking_agents_with_bands(tmp_path):
     success, n = _offline(rng)
     res = CS.run_study(success, n, None, CS.cost_samples(400, seed=1), agent_names=["a", "b", "silent"], bins=8)
     assert res["marginals"]["se"].shape == (4, 8, 3) and res["asks"].tolist() == [True, True, False]
-    fig = CS.marginal_wsr_figure(res)
+    fig = CF.marginal_wsr_figure(res)
     axes = fig.axes
     assert [ax.get_title() for ax in axes] == ["Type 1 appearance", "Type 2 region", "Type 3 route",
                                                "Type 4 confirmation"]
@@ -177,7 +178,7 @@ def test_marginal_wsr_zooms_on_the_asking_agents_with_bands(tmp_path):
     assert "locked cost" in labels
     _assert_outside(fig, legend, axes)
     assert axes[0].get_ylabel().startswith("mean WSR")
-    _written(lambda: CS.marginal_wsr_figure(res), tmp_path / "marginal.png")
+    _written(lambda: CF.marginal_wsr_figure(res), tmp_path / "marginal.png")
 
 
 # ---------------------------------------------------------------------------

@@ -16,6 +16,7 @@ import io
 import importlib
 import inspect
 import os
+import threading
 import warnings
 from pathlib import Path
 
@@ -111,6 +112,7 @@ class ArrayStore:
         self.bound_bytes = int(bound_bytes)
         self._unwritable = False
         self._bytes: int | None = None  # the store's size as this process last counted it, plus its writes since
+        self._counting = threading.Lock()  # threads write side by side (scene files loaded in parallel)
 
     def path(self, kind: str, key: str) -> Path:
         return self.root / kind / f"{key}.npz"
@@ -156,10 +158,10 @@ class ArrayStore:
             warnings.warn(f"ignjax cache: cannot write under {self.root} ({e.strerror or e}); going on without it",
                           CacheWarning, stacklevel=2)
             return False
-        # the folder is listed once, then again only when the count passes the bound (not after every write)
-        self._bytes = self._evict() if self._bytes is None else self._bytes + len(data)
-        if self._bytes > self.bound_bytes:
-            self._bytes = self._evict()
+        with self._counting:  # the folder is listed once, then again only when the count passes the bound
+            self._bytes = self._evict() if self._bytes is None else self._bytes + len(data)
+            if self._bytes > self.bound_bytes:
+                self._bytes = self._evict()
         return True
 
     def _evict(self) -> int:

@@ -24,23 +24,42 @@ from ignjax.scenes.navgrid import NavGrid
 _REL_TOL = 4e-7  # about 3 float32 ulps
 
 
-def _sweep(d: jax.Array, w: jax.Array, axis: int, reverse: bool) -> jax.Array:
-    """One directional relaxation pass along ``axis`` (a ``lax.scan``).
+def _sweep(d: jax.Array, w: jax.Array, axis: int, reverse: bool, n: jax.Array | None = None) -> jax.Array:
+    """One directional relaxation pass along ``axis``.
 
     ``w[i]`` is the cost of the edge from element ``i - 1`` (``i + 1`` when
     ``reverse``) to element ``i`` along ``axis``, +inf when absent; the pass
     computes ``d'[i] = min(d[i], d'[i -/+ 1] + w[i])``, so it relaxes a whole
     straight run of cells at once.
+
+    ``n`` (a traced int, optional) limits the pass to the first ``n``
+    elements along ``axis``: a grid padded to a shared shape
+    (:func:`goal_fields`) is relaxed over its own rows or columns only. The
+    elements past ``n`` are left as they are, which is what a full pass
+    gives them there (padding is +inf with +inf edges), and the first ``n``
+    see the same carried value (+inf) as a full pass would bring them, so
+    the result is the same bytes; the pass then costs ``n`` steps instead of
+    ``d.shape[axis]``. Without ``n``, a ``lax.scan`` over the whole axis.
     """
     dm = jnp.moveaxis(d, axis, 0)
     wm = jnp.moveaxis(w, axis, 0)
+    start = jnp.full(dm.shape[1:], jnp.inf, dm.dtype)
+    if n is None:
+        def step(prev, x):
+            di, wi = x
+            cur = jnp.minimum(di, prev + wi)
+            return cur, cur
 
-    def step(prev, x):
-        di, wi = x
-        cur = jnp.minimum(di, prev + wi)
-        return cur, cur
+        _, out = jax.lax.scan(step, start, (dm, wm), reverse=reverse)
+    else:
+        def body(i, carry):
+            out, prev = carry
+            j = n - 1 - i if reverse else i
+            cur = jnp.minimum(jax.lax.dynamic_index_in_dim(out, j, keepdims=False),
+                              prev + jax.lax.dynamic_index_in_dim(wm, j, keepdims=False))
+            return jax.lax.dynamic_update_index_in_dim(out, cur, j, 0), cur
 
-    _, out = jax.lax.scan(step, jnp.full(dm.shape[1:], jnp.inf, dm.dtype), (dm, wm), reverse=reverse)
+        out, _ = jax.lax.fori_loop(0, n, body, (dm, start))
     return jnp.moveaxis(out, 0, axis)
 
 
@@ -83,7 +102,7 @@ def _edge_costs(nav: jax.Array, res: float):
 
 
 def geodesic_field(navigable: jax.Array, seeds: jax.Array, resolution: float,
-                   max_rounds: int | None = None) -> jax.Array:
+                   max_rounds: int | None = None, extent: tuple | None = None) -> jax.Array:
     """Geodesic distance from seed cells over the navigable grid.
 
     The graph is the 8-connected grid of navigable cells: orthogonal steps
@@ -107,6 +126,10 @@ def geodesic_field(navigable: jax.Array, seeds: jax.Array, resolution: float,
             seeds on non-navigable cells are ignored.
         resolution: cell size, metres (static).
         max_rounds: optional cap on the rounds (None: H * W, never reached).
+        extent: optional ``(rows, cols)`` (ints, may be traced): the grid's
+            own size when it is padded (not navigable) to a larger shared
+            shape; the sweeps then run over those rows and columns only (the
+            same result, in less time; :func:`_sweep`).
 
     Returns:
         (H, W) float32 distances in metres, +inf where no seed is reachable
@@ -135,18 +158,20 @@ def geodesic_field(navigable: jax.Array, seeds: jax.Array, resolution: float,
         w_ur = skew(w["from_ur"], anti_flat)
         w_dl = skew(w["from_dl"], anti_flat)
 
+        rows, cols = (None, None) if extent is None else extent  # the skewed arrays keep the grid's rows
+
         def one_round(d):
-            d = _sweep(d, w["from_left"], axis=1, reverse=False)
-            d = _sweep(d, w["from_right"], axis=1, reverse=True)
-            d = _sweep(d, w["from_up"], axis=0, reverse=False)
-            d = _sweep(d, w["from_down"], axis=0, reverse=True)
+            d = _sweep(d, w["from_left"], 1, False, cols)
+            d = _sweep(d, w["from_right"], 1, True, cols)
+            d = _sweep(d, w["from_up"], 0, False, rows)
+            d = _sweep(d, w["from_down"], 0, True, rows)
             s = skew(d, fwd_flat)
-            s = _sweep(s, w_ul, axis=0, reverse=False)
-            s = _sweep(s, w_dr, axis=0, reverse=True)
+            s = _sweep(s, w_ul, 0, False, rows)
+            s = _sweep(s, w_dr, 0, True, rows)
             d = unskew(s, fwd_back)
             s = skew(d, anti_flat)
-            s = _sweep(s, w_ur, axis=0, reverse=False)
-            s = _sweep(s, w_dl, axis=0, reverse=True)
+            s = _sweep(s, w_ur, 0, False, rows)
+            s = _sweep(s, w_dl, 0, True, rows)
             return unskew(s, anti_back)
 
         cap = H * W if max_rounds is None else int(max_rounds)
@@ -240,10 +265,12 @@ GRID_PAD = 32
 """:func:`goal_fields` pads a grid's rows and columns to multiples of this."""
 
 
-def _object_field(navigable, room, origin, resolution, center, half_extents, yaw, room_index, seed_radius):
-    """Geodesic field to one object: :func:`seeds_from_box`, then :func:`geodesic_field`."""
+def _object_field(navigable, room, origin, resolution, center, half_extents, yaw, room_index, seed_radius,
+                  extent=None):
+    """Geodesic field to one object: :func:`seeds_from_box`, then :func:`geodesic_field`
+    (``extent``: the grid's own rows and columns, see there)."""
     seeds = seeds_from_box(navigable, room, origin, resolution, center, half_extents, yaw, room_index, seed_radius)
-    return geodesic_field(navigable, seeds, resolution)
+    return geodesic_field(navigable, seeds, resolution, extent=extent)
 
 
 FIELD_AXIS = "fields"
@@ -255,13 +282,16 @@ def _fields_program(parts: int, resolution: float, seed_radius: float):
     over targets, the targets split over this process's first ``parts``
     devices (on CPU one device per core; a field's lanes never mix, so the
     bytes are the same on any number of devices). Compiled once per padded
-    grid shape, K, device count, resolution and seed radius."""
+    grid shape, K, device count, resolution and seed radius; the grid's own
+    size (``extent``, (2,) int32: its rows and columns inside the padded
+    shape) is an argument, so scenes of any size share the program and each
+    pays for its own rows and columns."""
     mesh = Mesh(np.array(jax.local_devices()[:parts]), (FIELD_AXIS,))
-    fields = jax.vmap(lambda nav, room, origin, c, h, yaw, r: _object_field(nav, room, origin, resolution, c, h, yaw,
-                                                                            r, seed_radius),
-                      in_axes=(None, None, None, 0, 0, 0, 0))
+    fields = jax.vmap(lambda nav, room, origin, extent, c, h, yaw, r: _object_field(
+        nav, room, origin, resolution, c, h, yaw, r, seed_radius, (extent[0], extent[1])),
+        in_axes=(None, None, None, None, 0, 0, 0, 0))
     lanes = P(FIELD_AXIS)
-    return jax.jit(jax.shard_map(fields, mesh=mesh, in_specs=(P(), P(), P(), lanes, lanes, lanes, lanes),
+    return jax.jit(jax.shard_map(fields, mesh=mesh, in_specs=(P(), P(), P(), P(), lanes, lanes, lanes, lanes),
                                  out_specs=lanes, check_vma=False))
 
 
@@ -298,7 +328,8 @@ def goal_fields(grid: NavGrid, boxes: list, room_indices: list[int], seed_radius
     extra = -K % parts  # K padded to whole shares with copies of the last target
     boxes, rooms = list(boxes) + [boxes[-1]] * extra, list(room_indices) + [room_indices[-1]] * extra
     out = _fields_program(parts, float(grid.resolution), float(seed_radius))(
-        nav, room, np.asarray(grid.origin, np.float32), np.array([b.center for b in boxes], np.float32),
+        nav, room, np.asarray(grid.origin, np.float32), np.array([H, W], np.int32),
+        np.array([b.center for b in boxes], np.float32),
         np.array([b.half_extents for b in boxes], np.float32), np.array([b.yaw for b in boxes], np.float32),
         np.array(rooms, np.int32))
     return np.asarray(out)[:K, :H, :W]

@@ -5,7 +5,8 @@ trajectories, episode difficulty factors).
   from cue statistics (and lambda fitted to the locked costs).
 * :mod:`~ignjax.studies.cost_sensitivity`: WSR re-weighted under up to
   millions of alternative question-cost vectors, agent rankings and where
-  they flip relative to the locked costs.
+  they flip relative to the locked costs (its figures:
+  :mod:`~ignjax.studies.cost_figures`; the arithmetic runs without matplotlib).
 * :mod:`~ignjax.studies.difficulty_ablation`: episode difficulty under a grid
   of alpha coefficients and bin thresholds; whether per-bin success is
   ordered easy >= medium >= hard; alpha calibrated against failures on a

@@ -6,11 +6,8 @@ import os
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 
 from ignjax.errors import InputError
-from ignjax.scenes.viz.mapplot import save_figure
 
 
 def as_array(x, name: str, *, ndim: int | tuple[int, ...] | None = None, last: int | None = None,
@@ -46,7 +43,11 @@ def class_counts(cls: np.ndarray, difficulty: np.ndarray, n_classes: int = 4):
 
 
 def new_figure(nrows: int = 1, ncols: int = 1, size=(6.0, 4.0)):
-    """A matplotlib figure (Agg canvas, no pyplot state) and its axes array."""
+    """A matplotlib figure (Agg canvas, no pyplot state) and its axes array
+    (matplotlib is imported here: the studies' arithmetic runs without it)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
     fig = Figure(figsize=size)
     FigureCanvasAgg(fig)
     axes = fig.subplots(nrows, ncols, squeeze=False)
@@ -55,5 +56,7 @@ def new_figure(nrows: int = 1, ncols: int = 1, size=(6.0, 4.0)):
 
 def save(fig, path: str | os.PathLike, dpi: int = 120) -> Path:
     """Write ``fig`` as PNG atomically (temporary name, then rename)."""
+    from ignjax.scenes.viz.mapplot import save_figure
+
     fig.tight_layout()
     return save_figure(fig, path, dpi=dpi)

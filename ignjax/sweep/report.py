@@ -25,6 +25,7 @@ from ignjax.evaluate.outcomes import (metric_rows, model_totals, outcome_rows, w
 from ignjax.fileio import atomic_write
 from ignjax.protocol import BIN_INDEX, BIN_NAMES, FACTOR_NAMES
 from ignjax.studies import cost_derivation as C
+from ignjax.studies import cost_figures as CF
 from ignjax.studies import cost_sensitivity as CS
 from ignjax.studies import difficulty_ablation as DA
 from ignjax.studies import interaction as IA
@@ -133,8 +134,8 @@ def study_costs(es, rollouts: dict, in_loop: dict | None, cfg: SweepConfig, out:
     res = CS.run_study(arr["success"], arr["n_questions"], arr["valid"], costs, agent_names=arr["names"],
                        threshold_index=ti)
     fig = out / "figures"
-    CS.plot_marginal_wsr(res, fig / "costs_marginal_wsr.png")
-    CS.plot_flip_map(res, fig / "costs_flip_map.png")
+    CF.plot_marginal_wsr(res, fig / "costs_marginal_wsr.png")
+    CF.plot_flip_map(res, fig / "costs_flip_map.png")
     ranked = res["wsr_ranked"]
     rows = []
     for a, name in enumerate(res["agent_names"]):

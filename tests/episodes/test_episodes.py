@@ -450,6 +450,13 @@ def test_loader_rejects_unknown_scene_and_missing_scene_file(bench, tmp_path):
     with pytest.raises(EpisodeError) as e:
         load_benchmark(path, scenes_root=bench["root"])
     assert f"episode {recs[1]['episode_id']}: scene_file" in str(e.value) and "gone.usda" in str(e.value)
+    # files are read side by side: of two bad ones, the first in path order is named, whatever the records' order
+    recs = _one_scene_records(bench)
+    recs[0]["scene_file"], recs[1]["scene_file"] = "z_gone.usda", "a_gone.usda"
+    path = write_lines(tmp_path / "g.jsonl", recs)
+    with pytest.raises(EpisodeError) as e:
+        load_benchmark(path, scenes_root=bench["root"])
+    assert f"episode {recs[1]['episode_id']}: scene_file" in str(e.value) and "a_gone.usda" in str(e.value)
 
 
 def test_loader_rejects_unknown_target_and_starts_off_the_navigable_area(bench, tmp_path):

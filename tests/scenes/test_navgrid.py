@@ -16,7 +16,7 @@ from scipy.spatial import cKDTree
 
 from ignjax.errors import ConfigError, SceneError
 from ignjax.scenes.compile import compile_scene
-from ignjax.scenes.geodesic import geodesic_field, target_seeds
+from ignjax.scenes.geodesic import _sweep, geodesic_field, target_seeds
 from ignjax.scenes.model import Attributes, Geom, Instance, OrientedBox
 from ignjax.scenes.navgrid import GridConfig, build_navgrid, check_reachable, unreachable_rooms
 from ignjax.scenes.procgen.generate import HouseParams, generate_house
@@ -393,6 +393,52 @@ def test_geodesic_matches_dijkstra(two_room, house, blocked_door_scene, geodesic
     d = np.asarray(geodesic_jit(jnp.asarray(blocked.navigable), _batch3(seeds), blocked.resolution))[0]
     assert np.isinf(d[blocked.room == 1]).all()
     assert np.isfinite(d[blocked.navigable & (blocked.room == 0)]).all()
+
+
+@pytest.mark.parametrize("axis,reverse", [(0, False), (0, True), (1, False), (1, True)])
+def test_sweep_over_extent_is_one_full_pass(axis, reverse):
+    """One relaxation pass limited to the first n rows / columns (``_sweep``'s
+    ``n``) equals the full pass there and leaves the rest as it was."""
+    rng = np.random.default_rng(axis * 2 + reverse)
+    d = rng.uniform(0, 5, (9, 7)).astype(np.float32)
+    wts = np.where(rng.random((9, 7)) < 0.8, rng.uniform(0.1, 1, (9, 7)), np.inf).astype(np.float32)
+    n = 5
+    cut = (slice(None, n), slice(None)) if axis == 0 else (slice(None), slice(None, n))
+    ref = np.asarray(_sweep(jnp.asarray(d[cut]), jnp.asarray(wts[cut]), axis, reverse))
+    got = np.asarray(jax.jit(lambda a, b, k: _sweep(a, b, axis, reverse, k))(jnp.asarray(d), jnp.asarray(wts), n))
+    assert got[cut].tobytes() == ref.tobytes()
+    rest = (slice(n, None), slice(None)) if axis == 0 else (slice(None), slice(n, None))
+    assert got[rest].tobytes() == d[rest].tobytes()
+    assert not np.array_equal(ref, d[cut])  # the pass relaxed something
+
+
+def test_geodesic_extent_same_bytes(house):
+    """Sweeping a padded grid over its own rows and columns only (``extent``,
+    what goal_fields does on a bank's shared shape) gives the full sweep's
+    bytes: in the grid and in the padding."""
+    grid = house[1]
+    nav = grid.navigable
+    h, w = nav.shape
+    rng = np.random.default_rng(5)
+    cells = np.argwhere(nav)
+    seeds = np.full(nav.shape, np.inf, np.float32)
+    pick = cells[rng.choice(len(cells), 3, replace=False)]
+    seeds[pick[:, 0], pick[:, 1]] = rng.uniform(0, 1, 3)
+    H, W = h + 37, w + 11
+    pnav = np.zeros((H, W), bool)
+    pnav[:h, :w] = nav
+    pseeds = np.full((H, W), np.inf, np.float32)
+    pseeds[:h, :w] = seeds
+    full = jax.jit(lambda n, s: geodesic_field(n, s, grid.resolution))
+    part = jax.jit(lambda n, s, e: geodesic_field(n, s, grid.resolution, extent=(e[0], e[1])))
+    ref = np.asarray(full(jnp.asarray(pnav), jnp.asarray(pseeds)))
+    got = np.asarray(part(jnp.asarray(pnav), jnp.asarray(pseeds), jnp.asarray([h, w], jnp.int32)))
+    assert got.tobytes() == ref.tobytes()
+    assert np.isfinite(got[:h, :w]).sum() > 100 and np.isinf(got[h:]).all() and np.isinf(got[:, w:]).all()
+    own = np.asarray(full(jnp.asarray(nav), jnp.asarray(seeds)))  # the grid without padding: the same bytes
+    assert got[:h, :w].tobytes() == own.tobytes()
+    whole = np.asarray(part(jnp.asarray(pnav), jnp.asarray(pseeds), jnp.asarray([H, W], jnp.int32)))
+    assert whole.tobytes() == ref.tobytes()
 
 
 def test_target_seeds(two_room, geodesic_jit):

@@ -6,6 +6,8 @@ hand-built case whose answer is known in advance.
 """
 
 import math
+import subprocess
+import sys
 from types import SimpleNamespace
 
 import numpy as np
@@ -15,6 +17,7 @@ import scipy.stats
 from ignjax.evaluate import metrics as M
 from ignjax.episodes.difficulty import score_and_bin
 from ignjax.errors import ConfigError, InputError
+from ignjax.studies import cost_figures as CF
 from ignjax.studies import cost_sensitivity as CS
 from ignjax.studies import difficulty_ablation as DA
 from ignjax.studies import interaction as IA
@@ -492,7 +495,7 @@ def test_plots_write_pngs(tmp_path):
     ev = IA.events_from_rows(rows)
     loc = LOC.type3_locations(_grid(CORRIDOR), traj.pose, ev)
     calls = [
-        (CS.plot_marginal_wsr, res), (CS.plot_flip_map, res), (DA.plot_ordering, abl), (DA.plot_calibration, cal),
+        (CF.plot_marginal_wsr, res), (CF.plot_flip_map, res), (DA.plot_ordering, abl), (DA.plot_calibration, cal),
         (IP.plot_question_timing, IA.question_timing(ev)), (IP.plot_location_classes, loc),
         (IP.plot_questions_per_difficulty, IA.questions_per_difficulty(IA.counts_from_events(ev), ev["difficulty"])),
         (IP.plot_delta_u, IA.delta_u(traj.pose, ev, h=3)),
@@ -502,3 +505,17 @@ def test_plots_write_pngs(tmp_path):
         assert fn(result, path) == path
         assert path.read_bytes()[:8] == PNG, fn.__name__
     assert sorted(p.name for p in (tmp_path / "figs").iterdir()) == sorted(f"{fn.__name__}.png" for fn, _ in calls)
+
+
+def test_the_cost_arithmetic_imports_no_matplotlib():
+    """The sweep's configuration check and the bench import the cost study's
+    arithmetic; matplotlib (about half a second to import) comes only with its
+    figures (ignjax.studies.cost_figures)."""
+    code = ("import sys, ignjax.config, ignjax.studies.cost_sensitivity, ignjax.bench.rollouts; "
+            "print(sorted(m for m in sys.modules if m.split('.')[0] == 'matplotlib'))")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == "[]"
+    code = "import sys, ignjax.studies.cost_figures; print('matplotlib.figure' in sys.modules)"
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.stdout.strip() == "True", proc.stderr

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import threading
 import warnings
 from pathlib import Path
 from typing import Callable
@@ -25,6 +26,14 @@ import numpy as np
 from ignjax.cache import code_digest, derived_store, digest
 from ignjax.scenes.model import Scene
 from ignjax.scenes.model.scenejson import scene_from_dict, scene_to_json
+
+
+_RECORDING = threading.Lock()
+"""Held while a read's warnings are recorded: :func:`warnings.catch_warnings`
+swaps the process's warning state, so two threads' reads (scene files loaded
+side by side, :func:`ignjax.episodes.dataset.open_benchmark`) take turns; a
+warning another thread gives meanwhile is recorded here and given again, so
+it is shown all the same (that read is then not kept)."""
 
 
 def _file_digest(p: Path) -> str | None:
@@ -58,7 +67,7 @@ def read_remembered(path: Path, kind: str, read: Callable[[], tuple[Scene, tuple
         deps = json.loads(got["deps"].tobytes().decode())
         if all(_file_digest(Path(f)) == h for f, h in deps.items()):
             return scene_from_dict(json.loads(got["scene"].tobytes().decode()), str(path))
-    with warnings.catch_warnings(record=True) as caught:
+    with _RECORDING, warnings.catch_warnings(record=True) as caught:  # the warnings state is the process's
         warnings.simplefilter("always")
         scene, used = read()
     for w in caught:  # given again where they were raised, as if not caught
