@@ -44,7 +44,6 @@ Rankings
 from __future__ import annotations
 
 import math
-import os
 from functools import partial
 
 import jax
