@@ -1,7 +1,6 @@
 """Cost derivation on the paper's published statistics and on annotation files."""
 
 import json
-import math
 
 import numpy as np
 import pytest
