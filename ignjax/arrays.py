@@ -69,6 +69,19 @@ def on_device(x, dtype=None) -> jax.Array:
     return jax.device_put(np.asarray(x, dtype))
 
 
+def take_rows(tree, idx):
+    """Rows ``idx`` of every leaf of a pytree of arrays, cut on the host and
+    put on the device (:func:`on_device`'s reason: indexing device arrays
+    runs one small compiled program per leaf shape and dtype)."""
+    return jax.device_put(jax.tree.map(lambda a: np.asarray(a)[idx], tree))
+
+
+def stack_copies(tree, n: int):
+    """Every leaf of a pytree repeated along a new leading axis of ``n`` (a
+    sweep's settings), built on the host and put on the device."""
+    return jax.device_put(jax.tree.map(lambda a: np.broadcast_to(np.asarray(a), (n,) + np.shape(a)).copy(), tree))
+
+
 def tree_select(pred, on_true, on_false):
     """Elementwise ``where`` over two pytrees of the same structure; ``pred``
     selects along the leading axes (a () pred a whole tree, a (B,) pred rows
@@ -172,4 +185,4 @@ def field_docs(cls: type) -> dict[str, str]:
 
 
 __all__ = ["batch_of_one", "field_docs", "numpy_tree", "on_device", "only_row", "parse_assignment", "parse_floats",
-           "pytree_dataclass", "tree_select", "xp"]
+           "pytree_dataclass", "stack_copies", "take_rows", "tree_select", "xp"]

@@ -9,10 +9,10 @@ import dataclasses
 import time
 
 import jax
-import jax.numpy as jnp
 import numpy as np
 
 from ignjax.agents import get_agent
+from ignjax.arrays import on_device, stack_copies, take_rows
 from ignjax.bench.timing import log, timed
 from ignjax.protocol import LOCKED_COSTS
 from ignjax.sim.rollout import episode_keys, rollout, rollout_sweep
@@ -38,7 +38,7 @@ def bench_steps(es, world, agents, sizes) -> tuple[dict, float]:
         out[name] = {}
         for B in sizes:
             idx = np.arange(B) % len(es)
-            specs = jax.tree.map(lambda a: a[idx], es.specs)
+            specs = take_rows(es.specs, idx)
             keys = episode_keys(0, np.arange(B))
             t = time.perf_counter()
             res = rollout(world, specs, agent, params, keys)
@@ -61,10 +61,10 @@ def in_loop_sweep(es, world, K: int, E: int = 500):
     agent = get_agent("eig")
     base = agent.default_params()
     scales = np.geomspace(0.25, 8.0, K)
-    params = jax.tree.map(lambda x: jnp.broadcast_to(x, (K,) + jnp.shape(x)), base)
-    params = dataclasses.replace(params, costs=jnp.asarray(scales[:, None] * np.asarray(LOCKED_COSTS), jnp.float32))
+    params = dataclasses.replace(stack_copies(base, K),
+                                 costs=on_device(scales[:, None] * np.asarray(LOCKED_COSTS), np.float32))
     idx = np.arange(E) % len(es)
-    specs = jax.tree.map(lambda a: a[idx], es.specs)
+    specs = take_rows(es.specs, idx)
     keys = episode_keys(0, np.arange(E))
     return lambda: jax.block_until_ready(rollout_sweep(world, specs, agent, params, keys))
 

@@ -28,7 +28,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ignjax.arrays import on_device
+from ignjax.arrays import on_device, take_rows
 from ignjax.cache.clock import in_phase
 from ignjax.devices import available_cores
 from ignjax.episodes.difficulty import BIN_INDEX
@@ -86,7 +86,7 @@ class EpisodeSet:
     def subset(self, indices) -> "EpisodeSet":
         """The same benchmark restricted to some episodes (shares bank and fields)."""
         idx = np.asarray(indices, np.int64)
-        specs = jax.tree.map(lambda a: a[idx], self.specs)
+        specs = take_rows(self.specs, idx)
         return dataclasses.replace(self, records=[self.records[i] for i in idx], specs=specs,
                                    field_index=self.field_index[idx], key_index=self.key_index[idx])
 
@@ -155,7 +155,7 @@ def episode_specs(records: list[dict], bank: SceneBank, path: str | os.PathLike 
         fact_attrs=on_device([r["fact_attrs"] for r in rows], jnp.int32), fact_on=on_device([r["fact_on"] for r in rows], jnp.int32),
         fact_near=on_device([r["fact_near"] for r in rows], jnp.int32),
         region_category=on_device([r["region_category"] for r in rows], jnp.int32),
-        valid=jnp.ones(len(rows), bool),
+        valid=on_device(np.ones(len(rows), bool)),
     )
     return specs, list(pairs), np.asarray([r["field"] for r in rows], np.int32)
 
@@ -340,18 +340,24 @@ class BenchmarkScenes:
                                        categories=h.categories)
         p = self.path
         specs, pairs, field_index = episode_specs(records, bank, p)
-        fields = compute_fields(bank, pairs, field_batch, progress)
-        # reachability: the start must see a finite geodesic distance to its target (one gather for all)
+        fields = field_table(bank, pairs, field_batch, progress)
+        # reachability: the start must see a finite geodesic distance to its target (on the host, before upload)
         starts, scene = np.asarray(specs.start), np.asarray(specs.scene)
         cells = np.array([bank.navgrids[s].world_to_cell(xy) for s, xy in zip(scene, starts[:, :2])], np.int64)
-        at_start = np.asarray(fields[field_index, cells[:, 0], cells[:, 1]]) if len(records) else np.zeros(0)
+        at_start = fields[field_index, cells[:, 0], cells[:, 1]] if len(records) else np.zeros(0)
         for k in np.flatnonzero(~np.isfinite(at_start))[:1]:
             raise EpisodeError(p, f"episode {records[k]['episode_id']}: start", "the target cannot be reached from the start pose")
-        return EpisodeSet(p, records, bank, fields, specs, field_index, key_index=idx)
+        return EpisodeSet(p, records, bank, on_device(fields), specs, field_index, key_index=idx)
 
 
 def compute_fields(bank: SceneBank, pairs: list[tuple[int, int]], batch: int = FIELD_BATCH, progress=None) -> jax.Array:
-    """Geodesic fields (F, H, W) of (scene, instance) pairs on the bank's padded grid.
+    """Geodesic fields (F, H, W) of (scene, instance) pairs on the bank's padded grid, on the device
+    (:func:`field_table`, the host array)."""
+    return on_device(field_table(bank, pairs, batch, progress))
+
+
+def field_table(bank: SceneBank, pairs: list[tuple[int, int]], batch: int = FIELD_BATCH, progress=None) -> np.ndarray:
+    """Geodesic fields (F, H, W) of (scene, instance) pairs on the bank's padded grid (numpy).
 
     Each scene's targets go through
     :func:`~ignjax.scenes.derived.cached_goal_fields` (the on-disk cache in
@@ -377,4 +383,4 @@ def compute_fields(bank: SceneBank, pairs: list[tuple[int, int]], batch: int = F
         h, w = grid.shape
         for (f, _), field in zip(items, fields):
             out[f, :h, :w] = field
-    return on_device(out)
+    return out

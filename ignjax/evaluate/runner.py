@@ -11,6 +11,8 @@ widths can, in rare episodes; the device count does not).
 
 from __future__ import annotations
 
+import dataclasses
+
 import jax
 import numpy as np
 
@@ -20,7 +22,7 @@ from ignjax.cache.clock import in_phase
 from ignjax.agents import Agent, get_agent
 from ignjax.agents.params import make_params
 from ignjax.episodes.dataset import BenchmarkScenes, EpisodeSet
-from ignjax.sim.rollout import compile_ahead, episode_keys, pad_batch, rollout, rollout_call
+from ignjax.sim.rollout import compile_ahead, episode_keys, rollout, rollout_call
 from ignjax.sim.env import check_specs
 from ignjax.sim.world import FINE, World
 from ignjax.errors import ConfigError
@@ -53,16 +55,19 @@ def episode_batches(es: EpisodeSet, batch: int, seed: int = 0, progress=None, se
     of chunk starts (a progress bar)."""
     n = len(es)
     batch = max(1, min(int(batch), n))
-    keys_all = episode_keys(seed, es.key_index)
+    # cut on the host and put on the device whole: indexing the device tables would run one small
+    # compiled program per table and chunk shape (a dozen per run, each compiled or looked up in the cache)
+    host = jax.tree.map(np.asarray, es.specs)
+    key_index = np.asarray(es.key_index)
     starts = list(range(0, n, batch))
     if select is not None:
         starts = [starts[i] for i in select]
     for start in (progress(starts) if progress else starts):
-        idx = np.arange(start, min(start + batch, n))
-        specs = jax.tree.map(lambda a: a[idx], es.specs)
-        keys = keys_all[idx]
-        specs, keys = pad_batch(specs, keys, batch)
-        yield len(idx), specs, keys
+        n_real = min(batch, n - start)
+        idx = np.minimum(np.arange(start, start + batch), n - 1)  # pad_batch's padding: copies of the last row
+        specs = jax.tree.map(lambda a: a[idx], host)
+        specs = jax.device_put(dataclasses.replace(specs, valid=specs.valid & (np.arange(batch) < n_real)))
+        yield n_real, specs, episode_keys(seed, key_index[idx])
 
 
 def run_agent(es: EpisodeSet, agent: Agent | str, *, params=None, batch: int = 256, seed: int = 0,

@@ -257,7 +257,7 @@ def pack_probe_map(fine, groups: tuple[int, ...]) -> jax.Array:
             for g, m in enumerate(groups):
                 bit = ((blocks[:, :, i, :, j] & m) != 0).astype(np.uint32)
                 out |= bit << np.uint32(n * (FINE * i + j) + g)
-    return jnp.asarray(out)
+    return on_device(out)
 
 
 def packed_at(world: World, table, n_groups: int, s, xy):

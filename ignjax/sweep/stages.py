@@ -26,14 +26,13 @@ import sys
 import time
 from pathlib import Path
 
-import jax
-import jax.numpy as jnp
 import numpy as np
 from tqdm.auto import tqdm
 
 from ignjax.agents import get_agent
 from ignjax.agents.llm.catalog import LLM_AGENTS, get_llm_agent
 from ignjax.agents.params import plans_with_costs
+from ignjax.arrays import on_device, stack_copies
 from ignjax.config import SweepConfig, digest, fingerprint
 from ignjax.devices.parts import PartStore
 from ignjax.devices.processes import SINGLE, ProcessGroup
@@ -168,8 +167,7 @@ def _costs_params(cfg: SweepConfig, agent, costs):
     """The cost-aware agent's parameters, one row per charged cost vector (each setting plans with the vector it
     is charged)."""
     base = cfg.agents.make(agent.name, sim=cfg.sim)
-    params = jax.tree.map(lambda x: jnp.broadcast_to(x, (len(costs),) + jnp.shape(x)), base)
-    return dataclasses.replace(params, costs=jnp.asarray(costs, jnp.float32))
+    return dataclasses.replace(stack_copies(base, len(costs)), costs=on_device(costs, np.float32))
 
 
 def _stage_programs(es, world, work: dict, plans: dict, cfg: SweepConfig, c_agent, c_params) -> list:

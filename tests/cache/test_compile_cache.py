@@ -40,8 +40,9 @@ def test_main_job_twice_cold_then_warm_writes_the_same_bytes(small_benchmark, tm
     added = {p.name for p in (cache / "jax").iterdir()} - seen["entries"]
     assert not [n for n in added if n.startswith("jit_")], f"the second run compiled again: {sorted(added)[:5]}"
     assert runs["same_outputs"] is True
-    assert cold["compiled"] == cold["programs"] > 10 and cold["cache_hits"] == 0
-    assert warm["compiled"] == 0 and warm["cache_hits"] == warm["programs"] > 10
+    # at least the goal-field program, the rollout program and the episode keys' (tables go up by device_put)
+    assert cold["compiled"] == cold["programs"] >= 3 and cold["cache_hits"] == 0
+    assert warm["compiled"] == 0 and warm["cache_hits"] == warm["programs"] >= 3
     stored = list((cache / "programs" / "rollout").glob("*.npz"))  # the rollout programs, kept whole
     assert stored and cold["whole"] == 0 and warm["whole"] == len(stored), (len(stored), warm)
     for r in (cold, warm):
