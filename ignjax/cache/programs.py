@@ -185,6 +185,8 @@ def _leaf(x) -> tuple:
     if isinstance(x, jax.Array):
         aval = x.aval
         return ("array", tuple(aval.shape), str(aval.dtype), bool(aval.weak_type), stable(x.sharding))
+    if isinstance(x, jax.ShapeDtypeStruct):  # an array's shape and placement only: the same key as the array's
+        return ("array", tuple(x.shape), str(x.dtype), bool(x.weak_type), stable(x.sharding))
     if isinstance(x, (np.ndarray, np.generic)):
         return ("host", np.shape(x), np.asarray(x).dtype.str)
     if isinstance(x, (bool, int, float, complex)):

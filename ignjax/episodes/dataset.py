@@ -327,27 +327,49 @@ class BenchmarkScenes:
         """The :class:`EpisodeSet` of the records at ``positions`` (in that
         order): a bank of only the scenes they use (in the host bank's order,
         with the whole run's category vocabulary), their goal fields, and each
-        episode's :attr:`EpisodeSet.key_index` its position in the run.
+        episode's :attr:`EpisodeSet.key_index` its position in the run
+        (:meth:`prepare`, then :meth:`with_fields`).
 
         Raises:
             EpisodeError: a start that cannot reach its target.
         """
+        return self.with_fields(*self.prepare(positions), field_batch, progress)
+
+    @in_phase("load")
+    def prepare(self, positions) -> tuple[EpisodeSet, list[tuple[int, int]]]:
+        """:meth:`episode_set` without its goal fields: the set (``fields`` None;
+        the bank's tables on the device, the specs) and its (scene, instance)
+        target pairs, the rows of the fields :meth:`with_fields` computes. Every
+        shape of the simulator's world is known from it
+        (:func:`ignjax.sim.world.world_shapes`), so programs can compile while
+        the fields are computed."""
         idx = np.asarray(positions, np.int64)
         records = [self.records[i] for i in idx]
         h = self.host
         used = sorted({h.scene_index(r["scene_id"]) for r in records})
         bank = SceneBank.from_compiled([h.compiled[s] for s in used], [h.navgrids[s] for s in used],
                                        categories=h.categories)
-        p = self.path
-        specs, pairs, field_index = episode_specs(records, bank, p)
+        specs, pairs, field_index = episode_specs(records, bank, self.path)
+        return EpisodeSet(self.path, records, bank, None, specs, field_index, key_index=idx), pairs
+
+    @in_phase("load")
+    def with_fields(self, es: EpisodeSet, pairs: list[tuple[int, int]], field_batch: int = FIELD_BATCH,
+                    progress=None) -> EpisodeSet:
+        """A :meth:`prepare`-d set with its goal fields, each start checked to reach its target.
+
+        Raises:
+            EpisodeError: a start that cannot reach its target.
+        """
+        bank, records, specs, field_index = es.bank, es.records, es.specs, es.field_index
         fields = field_table(bank, pairs, field_batch, progress)
         # reachability: the start must see a finite geodesic distance to its target (on the host, before upload)
         starts, scene = np.asarray(specs.start), np.asarray(specs.scene)
         cells = np.array([bank.navgrids[s].world_to_cell(xy) for s, xy in zip(scene, starts[:, :2])], np.int64)
         at_start = fields[field_index, cells[:, 0], cells[:, 1]] if len(records) else np.zeros(0)
         for k in np.flatnonzero(~np.isfinite(at_start))[:1]:
-            raise EpisodeError(p, f"episode {records[k]['episode_id']}: start", "the target cannot be reached from the start pose")
-        return EpisodeSet(p, records, bank, on_device(fields), specs, field_index, key_index=idx)
+            raise EpisodeError(es.path, f"episode {records[k]['episode_id']}: start",
+                               "the target cannot be reached from the start pose")
+        return dataclasses.replace(es, fields=on_device(fields))
 
 
 def compute_fields(bank: SceneBank, pairs: list[tuple[int, int]], batch: int = FIELD_BATCH, progress=None) -> jax.Array:

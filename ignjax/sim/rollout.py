@@ -221,9 +221,14 @@ def replicate_world(world: World, mesh: Mesh) -> World:
     and mesh and dropped with the world: the scene bank is large (about half
     a gigabyte for the shipped benchmark), and copying it to the devices on
     every call would cost a good part of a batch's time. Each device holds
-    its own copy, CPU devices too."""
+    its own copy, CPU devices too. A world of shapes
+    (:func:`ignjax.sim.world.world_shapes`) gets the copies' placement."""
     if mesh.size == 1 or any(isinstance(x, jax.core.Tracer) for x in jax.tree.leaves(world)):
         return world
+    if all(isinstance(x, jax.ShapeDtypeStruct) for x in jax.tree.leaves(world)):
+        every = NamedSharding(mesh, P())
+        return jax.tree.map(lambda x: jax.ShapeDtypeStruct(x.shape, x.dtype, sharding=every, weak_type=x.weak_type),
+                            world)
     key = (id(world), mesh)
     hit = _REPLICAS.get(key)
     if hit is not None and hit[0]() is world:

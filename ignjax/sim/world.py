@@ -69,6 +69,24 @@ class World:
             object.__setattr__(self, "packed_obs", pack_probe_map(self.fine, (1 << n_col, 1 << (n_col + 1))))
 
 
+def world_shapes(bank: SceneBank, n_fields: int, config: T.SimConfig = T.SimConfig()) -> World:
+    """The :class:`World` of ``bank`` with ``n_fields`` goal fields as shapes
+    only (every leaf a :class:`jax.ShapeDtypeStruct` with the placement of
+    the bank's tables): what a rollout program is compiled for, known before
+    the fields and the probe map are computed
+    (:meth:`ignjax.episodes.dataset.BenchmarkScenes.prepare`), so the two
+    can go side by side (:func:`ignjax.evaluate.runner.bucket_worlds`)."""
+    ref = bank.grid.navigable
+    S, H, W = ref.shape
+
+    def like(shape, dtype):
+        return jax.ShapeDtypeStruct(shape, dtype, sharding=ref.sharding)
+
+    tables = jax.tree.map(lambda a: jax.ShapeDtypeStruct(a.shape, a.dtype, sharding=a.sharding,
+                                                         weak_type=a.aval.weak_type), bank)
+    return World(tables, like((n_fields, H, W), np.float32), config, fine=like((S, FINE * H, FINE * W), np.uint8),
+                 packed_obs=like((S, H, W), np.uint32))
+
 
 LOW_OBS_HEIGHT = 0.45
 

@@ -43,7 +43,7 @@ from ignjax.data import shipped
 from ignjax.errors import ConfigError, InputError
 from ignjax.evaluate.runner import BucketPlan, agent_batches, batch_program, bucket_worlds, episode_batches, plan_run
 from ignjax.scenes.io.sources import scene_sources
-from ignjax.sim.rollout import batch_parts, compile_ahead, rollout_sweep
+from ignjax.sim.rollout import batch_parts, rollout_sweep
 from ignjax.sweep.checkpoints import Checkpoints, prepare_folder
 from ignjax.sweep.report import in_loop_costs
 from ignjax.sweep.sections import write_outputs
@@ -206,8 +206,9 @@ def rollout_stage_parts(bs: BenchmarkScenes, plans: dict, todo: dict, cfg: Sweep
     if "costs/in_loop" in plans:
         costs, c_agent, _ = _costs_setup(cfg)
         c_params = _costs_params(cfg, c_agent, costs)
-    for es, world, work in bucket_worlds(bs, plans, todo, cfg.sim):
-        compile_ahead(_stage_programs(es, world, work, plans, cfg, c_agent, c_params))
+    for es, world, work in bucket_worlds(bs, plans, todo, cfg.sim,
+                                         lambda es, world, work: _stage_programs(es, world, work, plans, cfg, c_agent,
+                                                                                 c_params)):
         for stage, batches in work.items():
             if not batches:
                 continue

@@ -119,3 +119,38 @@ def test_bad_bank_budget_and_mllm_agents_on_several_buckets(small_benchmark, sce
     err = capsys.readouterr().err
     assert "--bank-mb" in err and "2 buckets" in err and "one bank" in err
     assert not (tmp_path / "o" / "outcomes.csv").exists()
+
+
+@pytest.mark.parametrize("parts", [1, 2])
+def test_programs_compiled_for_the_worlds_shapes_are_the_worlds(small_benchmark, parts):
+    """bucket_worlds compiles a bucket's rollout programs for the world's
+    shapes while its fields are computed: the shapes (world_shapes, from the
+    set without fields) give the same program keys, in this process
+    (compile_ahead) and in the program store, as the finished world, on one
+    device and replicated over two."""
+    from ignjax.agents import get_agent
+    from ignjax.agents.params import make_params
+    from ignjax.cache.programs import program_key
+    from ignjax.evaluate.runner import batch_program
+    from ignjax.sim import compact
+    from ignjax.sim.rollout import _program_key, _run_sharded
+    from ignjax.sim.world import world_shapes
+
+    if parts > len(jax.devices()):
+        pytest.skip(f"{parts} devices needed, {len(jax.devices())} here")
+    bs = open_benchmark(small_benchmark["path"])
+    pre, pairs = bs.prepare(np.arange(len(bs)))
+    assert pre.fields is None
+    es = bs.with_fields(pre, pairs)
+    world = make_world(es)
+    whole = bs.episode_set(np.arange(len(bs)))
+    assert np.asarray(es.fields).tobytes() == np.asarray(whole.fields).tobytes()
+    shapes = world_shapes(pre.bank, len(pairs), world.config)
+    assert all(isinstance(x, jax.ShapeDtypeStruct) for x in jax.tree.leaves(shapes))
+    agent = get_agent("eig")
+    params = make_params(agent, config=world.config)
+    ahead = batch_program(pre, shapes, agent, params, 8, 0, 0, parts)
+    real = batch_program(es, world, agent, params, 8, 0, 0, parts)
+    assert _program_key(*ahead) == _program_key(*real)
+    key = program_key(_run_sharded, *ahead, (compact.ONE_PASS,))
+    assert key is not None and key == program_key(_run_sharded, *real, (compact.ONE_PASS,))
