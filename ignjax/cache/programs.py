@@ -182,11 +182,9 @@ def _treedef(td) -> tuple:
 def _leaf(x) -> tuple:
     import jax
 
-    if isinstance(x, jax.Array):
-        aval = x.aval
+    if isinstance(x, (jax.Array, jax.ShapeDtypeStruct)):  # a ShapeDtypeStruct keys as the array it describes
+        aval = x.aval if isinstance(x, jax.Array) else x
         return ("array", tuple(aval.shape), str(aval.dtype), bool(aval.weak_type), stable(x.sharding))
-    if isinstance(x, jax.ShapeDtypeStruct):  # an array's shape and placement only: the same key as the array's
-        return ("array", tuple(x.shape), str(x.dtype), bool(x.weak_type), stable(x.sharding))
     if isinstance(x, (np.ndarray, np.generic)):
         return ("host", np.shape(x), np.asarray(x).dtype.str)
     if isinstance(x, (bool, int, float, complex)):

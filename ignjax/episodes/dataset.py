@@ -161,7 +161,7 @@ def episode_specs(records: list[dict], bank: SceneBank, path: str | os.PathLike 
 
 
 FIELD_BATCH = 8
-"""Goal fields computed per call when an episode set is built (:func:`compute_fields`): a scene's last call is padded
+"""Goal fields computed per call when an episode set is built (:func:`field_table`): a scene's last call is padded
 to it, so a small batch wastes little (the shipped scenes hold 30-41 targets: 448 fields computed for 408 at 8, 608
 at 32); a field is the same bytes whatever the batch."""
 
@@ -370,12 +370,6 @@ class BenchmarkScenes:
             raise EpisodeError(es.path, f"episode {records[k]['episode_id']}: start",
                                "the target cannot be reached from the start pose")
         return dataclasses.replace(es, fields=on_device(fields))
-
-
-def compute_fields(bank: SceneBank, pairs: list[tuple[int, int]], batch: int = FIELD_BATCH, progress=None) -> jax.Array:
-    """Geodesic fields (F, H, W) of (scene, instance) pairs on the bank's padded grid, on the device
-    (:func:`field_table`, the host array)."""
-    return on_device(field_table(bank, pairs, batch, progress))
 
 
 def field_table(bank: SceneBank, pairs: list[tuple[int, int]], batch: int = FIELD_BATCH, progress=None) -> np.ndarray:

@@ -11,7 +11,6 @@ widths can, in rare episodes; the device count does not).
 
 from __future__ import annotations
 
-import dataclasses
 from concurrent.futures import ThreadPoolExecutor
 
 import jax
@@ -23,7 +22,7 @@ from ignjax.cache.clock import in_phase
 from ignjax.agents import Agent, get_agent
 from ignjax.agents.params import make_params
 from ignjax.episodes.dataset import BenchmarkScenes, EpisodeSet
-from ignjax.sim.rollout import compile_ahead, episode_keys, rollout, rollout_call
+from ignjax.sim.rollout import compile_ahead, episode_keys, pad_index, pad_specs, rollout, rollout_call
 from ignjax.sim.env import check_specs
 from ignjax.sim.world import FINE, World, world_shapes
 from ignjax.errors import ConfigError
@@ -64,11 +63,9 @@ def episode_batches(es: EpisodeSet, batch: int, seed: int = 0, progress=None, se
     if select is not None:
         starts = [starts[i] for i in select]
     for start in (progress(starts) if progress else starts):
-        n_real = min(batch, n - start)
-        idx = np.minimum(np.arange(start, start + batch), n - 1)  # pad_batch's padding: copies of the last row
-        specs = jax.tree.map(lambda a: a[idx], host)
-        specs = jax.device_put(dataclasses.replace(specs, valid=specs.valid & (np.arange(batch) < n_real)))
-        yield n_real, specs, episode_keys(seed, key_index[idx])
+        rows = np.arange(start, min(start + batch, n))
+        specs = jax.device_put(pad_specs(jax.tree.map(lambda a: a[rows], host), batch))
+        yield len(rows), specs, episode_keys(seed, key_index[rows][pad_index(len(rows), batch)])
 
 
 def run_agent(es: EpisodeSet, agent: Agent | str, *, params=None, batch: int = 256, seed: int = 0,

@@ -304,7 +304,7 @@ def goal_fields(grid: NavGrid, boxes: list, room_indices: list[int], seed_radius
     of :data:`GRID_PAD` cells, so scenes of similar size share one; the
     padding does not change a field (it is never navigable). Benchmark
     construction calls it with a scene's candidates, the episode loader
-    (:func:`ignjax.episodes.dataset.compute_fields`) with its targets.
+    (:func:`ignjax.episodes.dataset.field_table`) with its targets.
 
     Args:
         grid: the navigation grid.

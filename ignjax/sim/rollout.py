@@ -541,16 +541,22 @@ def rollout_memory(world: World, specs: T.EpisodeSpec, agent, params, keys: jax.
     return {"arguments": arg, "outputs": out, "temporaries": tmp, "peak": arg + out + tmp - alias}
 
 
+def pad_index(n: int, size: int) -> np.ndarray:
+    """The rows of an ``n``-row batch padded to ``size`` rows: ``0 .. n - 1``,
+    then copies of the last row (:func:`pad_specs`)."""
+    return np.minimum(np.arange(max(n, size)), n - 1)
+
+
 def pad_specs(specs: T.EpisodeSpec, size: int) -> T.EpisodeSpec:
     """Pad a batch of specs to ``size`` rows with invalid copies of the last
     row (padding rows start finished and are masked out of every metric;
-    rows that were already padding stay padding)."""
+    rows that were already padding stay padding). Host (numpy) specs stay on
+    the host."""
     n = specs.scene.shape[0]
     if n >= size:
         return specs
-    idx = jnp.concatenate([jnp.arange(n), jnp.full(size - n, n - 1)])
-    out = jax.tree.map(lambda a: a[idx], specs)
-    return dataclasses.replace(out, valid=out.valid & (jnp.arange(size) < n))
+    out = jax.tree.map(lambda a: a[pad_index(n, size)], specs)
+    return dataclasses.replace(out, valid=out.valid & (np.arange(size) < n))
 
 
 def pad_batch(specs: T.EpisodeSpec, keys: jax.Array, size: int) -> tuple[T.EpisodeSpec, jax.Array]:

@@ -60,12 +60,12 @@ def corpus_fields(bench):
     """Geodesic fields of every corpus target on the loader's grids (the
     scene bank of the scenes read back from their USD files), not on the
     builder's (both use :func:`ignjax.scenes.geodesic.goal_fields`)."""
-    from ignjax.episodes.dataset import compute_fields
+    from ignjax.episodes.dataset import field_table
 
     bank = bench["set"].bank
     pairs = sorted({(bank.scene_index(r["scene_id"]), bank.instance_index(r["scene_id"], r["target_id"]))
                     for r in bench["corpus"]})
-    fields = np.asarray(compute_fields(bank, pairs))
+    fields = np.asarray(field_table(bank, pairs))
     return bank, {p: fields[k] for k, p in enumerate(pairs)}
 
 
