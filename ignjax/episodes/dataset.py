@@ -39,6 +39,7 @@ from ignjax.scenes.bank import SceneBank
 from ignjax.scenes.buckets import plan_buckets
 from ignjax.scenes.compile import compile_scene
 from ignjax.scenes.derived import cached_goal_fields, cached_navgrid
+from ignjax.scenes.fieldtable import FieldTable
 from ignjax.scenes.io.sources import load_scenes
 from ignjax.scenes.navgrid import GridConfig
 from ignjax.sim.types import EpisodeSpec
@@ -52,7 +53,8 @@ class EpisodeSet:
         path: the episode file.
         records: the released records, in file order.
         bank: scene bank of the scenes the records use.
-        fields: (F, H, W) float32 geodesic fields of the distinct targets.
+        fields: the geodesic fields of the distinct targets, a
+            :class:`~ignjax.scenes.fieldtable.FieldTable` on the device.
         specs: :class:`EpisodeSpec` with a leading axis of len(records).
         field_index: (E,) int32 field of each episode.
         key_index: (E,) int64 the position of each episode in the run's
@@ -364,16 +366,18 @@ class BenchmarkScenes:
         fields = field_table(bank, pairs, field_batch, progress)
         # reachability: the start must see a finite geodesic distance to its target (on the host, before upload)
         starts, scene = np.asarray(specs.start), np.asarray(specs.scene)
-        cells = np.array([bank.navgrids[s].world_to_cell(xy) for s, xy in zip(scene, starts[:, :2])], np.int64)
-        at_start = fields[field_index, cells[:, 0], cells[:, 1]] if len(records) else np.zeros(0)
+        cells = np.array([bank.navgrids[s].world_to_cell(xy) for s, xy in zip(scene, starts[:, :2])],
+                         np.int64).reshape(-1, 2)
+        at_start = fields.at(np.asarray(field_index), cells[:, 0], cells[:, 1])
         for k in np.flatnonzero(~np.isfinite(at_start))[:1]:
             raise EpisodeError(es.path, f"episode {records[k]['episode_id']}: start",
                                "the target cannot be reached from the start pose")
-        return dataclasses.replace(es, fields=on_device(fields))
+        return dataclasses.replace(es, fields=jax.device_put(fields))
 
 
-def field_table(bank: SceneBank, pairs: list[tuple[int, int]], batch: int = FIELD_BATCH, progress=None) -> np.ndarray:
-    """Geodesic fields (F, H, W) of (scene, instance) pairs on the bank's padded grid (numpy).
+def field_table(bank: SceneBank, pairs: list[tuple[int, int]], batch: int = FIELD_BATCH, progress=None) -> FieldTable:
+    """Geodesic fields of (scene, instance) pairs as a host :class:`~ignjax.scenes.fieldtable.FieldTable`
+    (numpy leaves; each field at its scene's own extent, read on the bank's padded grid).
 
     Each scene's targets go through
     :func:`~ignjax.scenes.derived.cached_goal_fields` (the on-disk cache in
@@ -381,12 +385,13 @@ def field_table(bank: SceneBank, pairs: list[tuple[int, int]], batch: int = FIEL
     benchmark construction uses), ``batch`` at a time, seed radius 1 m, on
     the bank's padded grid (one compiled program for every scene);
     ``progress`` wraps the iteration over scenes. Each call's targets are
-    split over the local devices (on CPU one per core). The bank's padding is
-    +inf. The fields equal :func:`~ignjax.scenes.bank.target_fields` on the
-    bank's grid, byte for byte (checked on the shipped benchmark).
+    split over the local devices (on CPU one per core). Read through
+    :meth:`~ignjax.scenes.fieldtable.FieldTable.at`, the fields equal
+    :func:`~ignjax.scenes.bank.target_fields` on the bank's grid, byte for
+    byte (checked on the shipped benchmark).
     """
     H, W = bank.grid.navigable.shape[1:]
-    out = np.full((len(pairs), H, W), np.inf, np.float32)
+    out: list[np.ndarray | None] = [None] * len(pairs)
     rooms = np.asarray(bank.instances.room)
     by_scene: dict[int, list[tuple[int, int]]] = {}
     for f, (s, i) in enumerate(pairs):
@@ -396,7 +401,6 @@ def field_table(bank: SceneBank, pairs: list[tuple[int, int]], batch: int = FIEL
         items, grid = by_scene[s], bank.navgrids[s]
         fields = cached_goal_fields(bank.compiled[s], grid, [i for _, i in items], [int(rooms[s, i]) for _, i in items],
                                     1.0, batch, (H, W))
-        h, w = grid.shape
         for (f, _), field in zip(items, fields):
-            out[f, :h, :w] = field
-    return out
+            out[f] = field
+    return FieldTable.of(out, (H, W))

@@ -204,7 +204,7 @@ def bucket_worlds(bs: BenchmarkScenes, plans: dict, todo: dict, config: SimConfi
             continue
         pre, pairs = bs.prepare(pos)
         with ThreadPoolExecutor(1) as pool:
-            ahead = pool.submit(compile_ahead, programs(pre, world_shapes(pre.bank, len(pairs), config), work)
+            ahead = pool.submit(compile_ahead, programs(pre, world_shapes(pre.bank, [s for s, _ in pairs], config), work)
                                 ) if programs else None
             es = bs.with_fields(pre, pairs)
             world = make_world(es, config)

@@ -14,7 +14,8 @@ evaluation then builds one bucket's bank at a time
 that grow with a scene's grid (the ray caster's voxel and segment tables,
 primitives, the navigation grid tables), ``per_cell`` more bytes per
 navigation cell for what the caller derives from the grid (the simulator's
-probe maps), and ``fields`` goal fields of 4 bytes a cell. The small
+probe maps), and each scene's goal fields of 4 bytes a cell of the scene's
+own grid (:class:`~ignjax.scenes.fieldtable.FieldTable`). The small
 per-instance, room and door tables are left out (a few kB a scene).
 """
 
@@ -25,6 +26,7 @@ from typing import Sequence
 import numpy as np
 
 from ignjax.errors import ConfigError
+from ignjax.scenes.fieldtable import padded_cells
 from ignjax.scenes.navgrid import NavGrid
 from ignjax.scenes.raygrid import ray_grid_arrays
 
@@ -39,8 +41,8 @@ def _table_shapes(grid: NavGrid) -> dict[str, tuple[tuple[int, ...], int]]:
     return out
 
 
-def _padded(shapes: Sequence[dict], fields: int, per_cell: int) -> int:
-    """:func:`padded_bytes` from the scenes' :func:`_table_shapes`."""
+def _padded(shapes: Sequence[dict], fields: Sequence[int], per_cell: int) -> int:
+    """:func:`padded_bytes` from the scenes' :func:`_table_shapes` and their goal-field counts."""
     if not shapes:
         return 0
     total = 0
@@ -48,18 +50,27 @@ def _padded(shapes: Sequence[dict], fields: int, per_cell: int) -> int:
         top = [max(d) for d in zip(*[s[name][0] for s in shapes])]
         total += len(shapes) * int(np.prod(top, dtype=np.int64)) * size
     h, w = (max(d) for d in zip(*[s["grid"][0] for s in shapes]))
-    return int(total + h * w * (len(shapes) * per_cell + 4 * fields))
+    extents = [s["grid"][0] for s, n in zip(shapes, fields) for _ in range(int(n))]
+    field_bytes = 4 * padded_cells(extents, (h, w)) + 12 * len(extents) if extents else 0
+    return int(total + h * w * len(shapes) * per_cell + field_bytes)
 
 
-def padded_bytes(grids: Sequence[NavGrid], fields: int = 0, per_cell: int = 0) -> int:
+def _per_scene(fields, n: int) -> list[int]:
+    return [int(fields)] * n if np.ndim(fields) == 0 else [int(f) for f in fields]
+
+
+def padded_bytes(grids: Sequence[NavGrid], fields: int | Sequence[int] = 0, per_cell: int = 0) -> int:
     """Estimated bytes of a bank of ``grids`` padded to their maxima (module docstring).
 
     Args:
         grids: the scenes' navigation grids.
-        fields: goal fields (one per distinct target) held beside the bank.
+        fields: goal fields (one per distinct target) each scene brings, held
+            beside the bank at the scene's own extent
+            (:class:`~ignjax.scenes.fieldtable.FieldTable`); one number: that
+            many for every scene.
         per_cell: further bytes per navigation cell of each scene (padded).
     """
-    return _padded([_table_shapes(g) for g in grids], fields, per_cell)
+    return _padded([_table_shapes(g) for g in grids], _per_scene(fields, len(grids)), per_cell)
 
 
 BUCKET_COST = 0.1
@@ -98,9 +109,9 @@ def plan_buckets(grids: Sequence[NavGrid], budget_bytes: float, fields: Sequence
     if not budget_bytes > 0:
         raise ConfigError(None, "budget", f"a bucket's byte budget must be positive, got {budget_bytes}")
     n = len(grids)
-    fields = [0] * n if fields is None else [int(f) for f in fields]
+    fields = [0] * n if fields is None else _per_scene(fields, n)
     shapes = [_table_shapes(g) for g in grids]
-    if _padded(shapes, sum(fields), per_cell) <= budget_bytes:
+    if _padded(shapes, fields, per_cell) <= budget_bytes:
         return [list(range(n))] if n else []
     order = sorted(range(n), key=lambda i: (grids[i].shape[0], grids[i].shape[1], i))
     # best[j]: the least cost of cutting order[:j]; cut[j]: where its last bucket starts
@@ -109,7 +120,7 @@ def plan_buckets(grids: Sequence[NavGrid], budget_bytes: float, fields: Sequence
     for j in range(1, n + 1):
         for i in range(j - 1, -1, -1):
             run = order[i:j]
-            size = _padded([shapes[k] for k in run], sum(fields[k] for k in run), per_cell)
+            size = _padded([shapes[k] for k in run], [fields[k] for k in run], per_cell)
             if size > budget_bytes and len(run) > 1:
                 break  # longer runs only grow
             cost = best[i] + size + BUCKET_COST * budget_bytes

@@ -258,7 +258,7 @@ def check_specs(world: World, specs: T.EpisodeSpec) -> None:
     fld = np.asarray(specs.field)
     n_scenes = len(world.bank.scene_ids)
     n_inst = np.asarray(world.bank.instances.valid)
-    n_fields = int(world.fields.shape[0])
+    n_fields = len(world.fields)
     for k in range(scene.shape[0]):
         if not 0 <= scene[k] < n_scenes:
             raise ConfigError(None, f"episodes[{k}].scene", f"scene index {int(scene[k])} is not in the bank ({n_scenes} scenes)")

@@ -51,7 +51,7 @@ def route_facts(world: World, ep: T.EpisodeSpec, pose):
     res = g.resolution
     n = int(math.ceil(cfg.hint_lookahead / res))
     row0, col0 = cell_index(world, s, pose[:2])
-    Hh, Ww = world.fields.shape[1:]
+    Hh, Ww = world.fields.shape
     nbr = jnp.array([[-1, -1], [-1, 0], [-1, 1], [0, -1], [0, 1], [1, -1], [1, 0], [1, 1]], jnp.int32)
     cost = jnp.where(jnp.all(nbr != 0, axis=1), res * math.sqrt(2), res).astype(jnp.float32)
     room0 = room_at(world, s, pose[:2])
@@ -60,8 +60,8 @@ def route_facts(world: World, ep: T.EpisodeSpec, pose):
         r, c, travelled, exit_r, exit_c, left = carry
         rr = jnp.clip(r + nbr[:, 0], 0, Hh - 1)
         cc = jnp.clip(c + nbr[:, 1], 0, Ww - 1)
-        vals = world.fields[fi, rr, cc]
-        here = world.fields[fi, jnp.clip(r, 0, Hh - 1), jnp.clip(c, 0, Ww - 1)]
+        vals = world.fields.at(fi, rr, cc)
+        here = world.fields.at(fi, r, c)
         k = jnp.argmin(vals)
         better = (vals[k] < here) & (travelled < cfg.hint_lookahead)
         nr = jnp.where(better, rr[k], r)

@@ -47,9 +47,7 @@ def geodesic_to_target(world: World, ep: T.EpisodeSpec, xy):
     g = world.bank.grid
     row, col = cell_index(world, ep.scene, xy)
     inside = (row >= 0) & (col >= 0) & (row < g.shape[ep.scene, 0]) & (col < g.shape[ep.scene, 1])
-    # index the field stack directly: `fields[ep.field]` under vmap would copy a whole field per episode
-    val = world.fields[ep.field, jnp.clip(row, 0, world.fields.shape[1] - 1), jnp.clip(col, 0, world.fields.shape[2] - 1)]
-    return jnp.where(inside, val, jnp.inf)
+    return jnp.where(inside, world.fields.at(ep.field, row, col), jnp.inf)
 
 
 def euclidean_to_target(world: World, ep: T.EpisodeSpec, xy):

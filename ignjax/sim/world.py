@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 from collections import OrderedDict
 from concurrent.futures import ThreadPoolExecutor
+from typing import Sequence
 
 import jax
 import jax.numpy as jnp
@@ -24,6 +25,7 @@ from ignjax.cache import array_digest, code_digest, derived_store, digest
 from ignjax.devices import available_cores
 from ignjax.errors import ConfigError
 from ignjax.scenes.bank import SceneBank
+from ignjax.scenes.fieldtable import FieldTable
 from ignjax.sim import types as T
 
 
@@ -33,8 +35,11 @@ class World:
 
     Attributes:
         bank: the scene bank.
-        fields: (F, H, W) float32 geodesic fields of the episodes' targets
-            (on the bank's padded grid); episodes index them by ``field``.
+        fields: the geodesic fields of the episodes' targets, a
+            :class:`~ignjax.scenes.fieldtable.FieldTable` (each field at its
+            scene's own extent); episodes index them by ``field``. An
+            (F, H, W) float32 stack on the bank's padded grid is taken too
+            and held as a table of whole padded fields (the same look-ups).
         config: static simulator configuration.
         fine: (S, FINE * H, FINE * W) uint8 probe map on cells of
             ``resolution / FINE`` (:data:`FINE` = 4), one bit per probe
@@ -56,12 +61,14 @@ class World:
     """
 
     bank: SceneBank
-    fields: jax.Array
+    fields: FieldTable
     config: T.SimConfig = T.SimConfig()
     fine: jax.Array | None = None
     packed_obs: jax.Array | None = None
 
     def __post_init__(self):
+        if not isinstance(self.fields, FieldTable):
+            object.__setattr__(self, "fields", FieldTable.from_dense(self.fields))
         if self.fine is None:
             object.__setattr__(self, "fine", remembered_probe_map(self.bank, self.config))
         n_col = len(self.config.collision_heights)
@@ -69,8 +76,8 @@ class World:
             object.__setattr__(self, "packed_obs", pack_probe_map(self.fine, (1 << n_col, 1 << (n_col + 1))))
 
 
-def world_shapes(bank: SceneBank, n_fields: int, config: T.SimConfig = T.SimConfig()) -> World:
-    """The :class:`World` of ``bank`` with ``n_fields`` goal fields as shapes
+def world_shapes(bank: SceneBank, field_scenes: Sequence[int], config: T.SimConfig = T.SimConfig()) -> World:
+    """The :class:`World` of ``bank`` with goal fields on the scenes ``field_scenes`` (one entry a field) as shapes
     only (every leaf a :class:`jax.ShapeDtypeStruct` with the placement of
     the bank's tables): what a rollout program is compiled for, known before
     the fields and the probe map are computed
@@ -84,7 +91,8 @@ def world_shapes(bank: SceneBank, n_fields: int, config: T.SimConfig = T.SimConf
 
     tables = jax.tree.map(lambda a: jax.ShapeDtypeStruct(a.shape, a.dtype, sharding=a.sharding,
                                                          weak_type=a.aval.weak_type), bank)
-    return World(tables, like((n_fields, H, W), np.float32), config, fine=like((S, FINE * H, FINE * W), np.uint8),
+    fields = FieldTable.shapes([bank.navgrids[int(s)].shape for s in field_scenes], (H, W), ref.sharding)
+    return World(tables, fields, config, fine=like((S, FINE * H, FINE * W), np.uint8),
                  packed_obs=like((S, H, W), np.uint32))
 
 

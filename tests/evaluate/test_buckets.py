@@ -33,7 +33,10 @@ def test_estimate_matches_the_worlds_arrays(scenes):
     fields) to within the small per-instance tables it leaves out."""
     for pos in [np.arange(len(scenes))] + [np.flatnonzero(scenes.scene_of() == s) for s in range(2)]:
         es = scenes.episode_set(pos)
-        est = padded_bytes(es.bank.navgrids, int(es.fields.shape[0]), WORLD_BYTES_PER_CELL)
+        targets = np.unique(np.stack([np.asarray(es.specs.scene), np.asarray(es.specs.field)], 1), axis=0)
+        per_scene = np.bincount(targets[:, 0], minlength=es.bank.n_scenes)
+        assert per_scene.sum() == len(es.fields)
+        est = padded_bytes(es.bank.navgrids, per_scene, WORLD_BYTES_PER_CELL)
         real = _world_bytes(make_world(es))
         assert est <= real and real - est < 64 * 1024, (est, real)
 
@@ -144,8 +147,9 @@ def test_programs_compiled_for_the_worlds_shapes_are_the_worlds(small_benchmark,
     es = bs.with_fields(pre, pairs)
     world = make_world(es)
     whole = bs.episode_set(np.arange(len(bs)))
-    assert np.asarray(es.fields).tobytes() == np.asarray(whole.fields).tobytes()
-    shapes = world_shapes(pre.bank, len(pairs), world.config)
+    assert all(np.asarray(a).tobytes() == np.asarray(b).tobytes()
+               for a, b in zip(jax.tree.leaves(es.fields), jax.tree.leaves(whole.fields)))
+    shapes = world_shapes(pre.bank, [s for s, _ in pairs], world.config)
     assert all(isinstance(x, jax.ShapeDtypeStruct) for x in jax.tree.leaves(shapes))
     agent = get_agent("eig")
     params = make_params(agent, config=world.config)

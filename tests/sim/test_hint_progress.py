@@ -77,7 +77,7 @@ def _geodesic(world, spec, xy) -> np.ndarray:
     col = np.floor((xy[:, 0] - origin[0]) / g.resolution).astype(int)
     row = np.floor((xy[:, 1] - origin[1]) / g.resolution).astype(int)
     inside = (row >= 0) & (col >= 0) & (row < shape[0]) & (col < shape[1])
-    field = np.asarray(world.fields[f])
+    field = world.fields.field(int(f))
     return np.where(inside, field[np.clip(row, 0, field.shape[0] - 1), np.clip(col, 0, field.shape[1] - 1)], np.inf)
 
 
