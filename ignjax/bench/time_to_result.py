@@ -13,6 +13,12 @@ folder (cold), then in another on that folder (warm):
   episodes (:func:`ignjax.bench.rollouts.in_loop_sweep`), after loading the
   benchmark and building its world.
 
+Each child asks for one CPU device per core before JAX starts, as the
+commands' own entry points do (``python -m ignjax.evaluate``), so a task runs
+on the devices the command would; the in-the-loop task, like the commands,
+starts loading the programs its last run used at once
+(:func:`ignjax.cache.programs.prefetch_programs`).
+
 Each run is split into ``load_s`` (reading the episode file, building the
 scenes' tables, goal fields and the world, outside compiling), ``compile_s``
 (tracing, lowering and compiling programs, or loading them from the
@@ -63,8 +69,10 @@ def _child(command: str, argv: list[str], out: Path) -> dict:
             raise SystemExit(rc)
     elif command == "in_loop":
         from ignjax.cache.compile import use_compile_cache
+        from ignjax.cache.programs import prefetch_programs
 
         use_compile_cache()
+        prefetch_programs(("in_loop", argv))
         from ignjax.bench.rollouts import in_loop_sweep
         from ignjax.episodes.dataset import load_benchmark
         from ignjax.evaluate.runner import make_world
@@ -132,6 +140,9 @@ def bench_time_to_result(episodes: str, log=None) -> dict:
 
 
 def main(argv=None) -> int:
+    from ignjax.devices import configure_cpu_devices
+
+    configure_cpu_devices()  # as the commands' own entry points do, before JAX starts: one CPU device per core
     command, out, *rest = sys.argv[1:] if argv is None else argv
     print(json.dumps(_child(command, rest, Path(out))))
     return 0
