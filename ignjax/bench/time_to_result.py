@@ -15,9 +15,7 @@ folder (cold), then in another on that folder (warm):
 
 Each child asks for one CPU device per core before JAX starts, as the
 commands' own entry points do (``python -m ignjax.evaluate``), so a task runs
-on the devices the command would; the in-the-loop task, like the commands,
-starts loading the programs its last run used at once
-(:func:`ignjax.cache.programs.prefetch_programs`).
+on the devices the command would.
 
 Each run is split into ``load_s`` (reading the episode file, building the
 scenes' tables, goal fields and the world, outside compiling), ``compile_s``
@@ -69,10 +67,8 @@ def _child(command: str, argv: list[str], out: Path) -> dict:
             raise SystemExit(rc)
     elif command == "in_loop":
         from ignjax.cache.compile import use_compile_cache
-        from ignjax.cache.programs import prefetch_programs
 
         use_compile_cache()
-        prefetch_programs(("in_loop", argv))
         from ignjax.bench.rollouts import in_loop_sweep
         from ignjax.episodes.dataset import load_benchmark
         from ignjax.evaluate.runner import make_world

@@ -20,16 +20,4 @@ def apply_cache_arguments(args) -> None:
     use_compile_cache(not args.no_compile_cache)
 
 
-def prefetch_command_programs(command: str, args) -> int:
-    """Start loading, in background threads, the stored programs the last
-    run of ``command`` with the same options used (the options less ``out``,
-    so a run written elsewhere counts as the same run;
-    :func:`~ignjax.cache.programs.prefetch_programs`). Call it once JAX's
-    runtime has joined (a run of several processes) and not in a launcher.
-    Returns how many started loading."""
-    from ignjax.cache.programs import prefetch_programs
-
-    return prefetch_programs((command, sorted((k, repr(v)) for k, v in vars(args).items() if k != "out")))
-
-
-__all__ = ["add_cache_arguments", "apply_cache_arguments", "prefetch_command_programs"]
+__all__ = ["add_cache_arguments", "apply_cache_arguments"]

@@ -22,9 +22,8 @@ tracing:
   ``untraced``) and every leaf's type, shape, dtype, weak type and
   placement.
 
-On a hit the serialised executable is loaded (about 1 s for a rollout
-program on the 2-core CPU, which :func:`prefetch_programs` starts ahead of
-use in a command run again); on a miss the program is lowered and compiled (through JAX's
+On a hit the serialised executable is loaded (about 0.6 s for a rollout
+program); on a miss the program is lowered and compiled (through JAX's
 persistent cache) and then stored. Anything this description cannot
 vouch for is never stored: a function or a type from outside ``ignjax``
 and the libraries above (an agent written in a notebook: its source is
@@ -63,7 +62,6 @@ import numpy as np
 from ignjax.cache.clock import PROGRAM_LOAD_EVENT
 from ignjax.cache.folder import cache_root
 from ignjax.cache.store import ArrayStore, CacheWarning, array_digest, code_digest, digest
-from ignjax.fileio import atomic_write
 
 PROGRAMS_BOUND_BYTES = 2 << 30
 """Size bound of the program store (a rollout program is about 6 MB)."""
@@ -247,14 +245,10 @@ def _serialise(lowered, compiled) -> dict[str, np.ndarray] | None:
             "devices": devices, "options": np.frombuffer(options, np.uint8)}
 
 
-def _executable(entry: dict[str, np.ndarray]) -> tuple:
-    """The executable of a stored entry, loaded for the devices it was
-    compiled for and with the compile options it was compiled with (XLA:CPU
-    finds its kernels by names that depend on them:
-    ``xla_cpu_use_fusion_emitters``), with what :func:`_program` needs to
-    wrap it: the slow half of a load (about 1 s for a rollout program on the
-    2-core CPU, without Python's lock), which :func:`prefetch_programs` runs
-    ahead of use."""
+def _deserialise(entry: dict[str, np.ndarray], args: tuple):
+    """The program of a stored entry, loaded for the devices it was compiled
+    for and with the compile options it was compiled with (XLA:CPU finds
+    its kernels by names that depend on them: ``xla_cpu_use_fusion_emitters``)."""
     import jax
     from jax._src import compiler
     from jax._src.lib import xla_client as xc
@@ -276,97 +270,8 @@ def _executable(entry: dict[str, np.ndarray]) -> tuple:
     unloaded, args_info_flat, no_kwargs = Unpickler(io.BytesIO(entry["executable"].tobytes()), backend,
                                                     devices).load()
     out_tree = pickle.load(io.BytesIO(entry["out_tree"].tobytes()))
-    return unloaded.load(), args_info_flat, no_kwargs, out_tree
-
-
-def _program(loaded: tuple, args: tuple):
-    """The compiled program of an :func:`_executable`, for arguments of its key's structure."""
-    import jax
-
-    executable, args_info_flat, no_kwargs, out_tree = loaded
     args_info = jax.tree.structure((tuple(args), {})).unflatten(args_info_flat)
-    return jax.stages.Compiled(executable, [], args_info, out_tree, no_kwargs=no_kwargs)
-
-
-PREFETCH_MAX = 8
-"""The most programs :func:`prefetch_programs` loads ahead."""
-_AHEAD_LOCK = threading.Lock()
-_AHEAD: dict = {"context": None, "used": [], "pending": {}, "pool": None}
-
-
-def _recent_path(store: ArrayStore, context: str):
-    return store.root / "recent" / f"{context}.json"
-
-
-def prefetch_programs(context) -> int:
-    """Start loading, in background threads, the stored programs that the
-    last run with the same ``context`` used (a command passes its name and
-    options, less where it writes), and record the programs this run uses
-    under ``context`` for the next. A command run again then loads its
-    programs while it reads its benchmark instead of after: XLA loads them
-    without Python's lock. Only a program whose key
-    (:func:`program_key`, computed from the real arguments when the program
-    is needed) equals a loaded one's is taken from them, so a wrong guess
-    (another benchmark at the same path, other shapes) costs background work
-    and never a result; the outputs are the same bytes either way.
-
-    Returns:
-        How many programs started loading (0 when the store is off or the
-        context has no record).
-    """
-    store = program_store()
-    if store is None:
-        return 0
-    import jax
-
-    ctx = digest("prefetch", context)
-    try:
-        recent = json.loads(_recent_path(store, ctx).read_text())["programs"][:PREFETCH_MAX]
-        recent = [(str(n), str(k)) for n, k in recent]
-    except (OSError, ValueError, KeyError, TypeError):
-        recent = []
-    jax.local_devices()  # the backend starts here, not in a worker
-    from concurrent.futures import ThreadPoolExecutor
-
-    from ignjax.devices import available_cores
-
-    def load(name: str, key: str):
-        entry = store.get(name, key)
-        return None if entry is None else _executable(entry)
-
-    with _AHEAD_LOCK:
-        _AHEAD.update(context=ctx, used=[], pending={})
-        if recent and _AHEAD["pool"] is None:
-            _AHEAD["pool"] = ThreadPoolExecutor(max(1, available_cores()), thread_name_prefix="ignjax-prefetch")
-        for name, key in recent:
-            _AHEAD["pending"][key] = _AHEAD["pool"].submit(load, name, key)
-    return len(recent)
-
-
-def _take_prefetched(key: str):
-    """The :func:`_executable` loaded ahead under ``key`` (waiting for it), or None."""
-    with _AHEAD_LOCK:
-        fut = _AHEAD["pending"].pop(key, None)
-    if fut is None:
-        return None
-    try:
-        return fut.result()
-    except Exception:  # noqa: BLE001 - an entry that did not load is loaded (or compiled) the usual way
-        return None
-
-
-def _note_used(name: str, key: str) -> None:
-    """Add a program to the record of this run's context (:func:`prefetch_programs`)."""
-    store = program_store()
-    with _AHEAD_LOCK:
-        ctx, used = _AHEAD["context"], _AHEAD["used"]
-        if ctx is None or store is None or [name, key] in used:
-            return
-        used.append([name, key])
-        try:
-            atomic_write(_recent_path(store, ctx), json.dumps({"programs": used}))
-        except OSError:
-            pass  # the store's own writes warn when the folder cannot be written
+    return jax.stages.Compiled(unloaded.load(), [], args_info, out_tree, no_kwargs=no_kwargs)
 
 
 _THREAD = threading.local()
@@ -432,30 +337,27 @@ def load_or_compile(fn, args: tuple, static: dict, name: str, context=()):
     store = program_store()
     key = program_key(fn, args, static, context) if store is not None else None
     if key is not None:
-        t0 = time.time()
-        loaded = _take_prefetched(key)
-        entry = store.get(name, key) if loaded is None else None
+        entry = store.get(name, key)
         if entry is not None:
+            t0 = time.time()
             try:
-                loaded = _executable(entry)
+                program = _deserialise(entry, args)
             except Exception as e:  # noqa: BLE001 - an entry that will not load is compiled again
                 warnings.warn(f"ignjax cache: a stored program in {store.path(name, key)} does not load "
                               f"({type(e).__name__}); compiling it again", CacheWarning, stacklevel=2)
-        if loaded is not None:
-            import jax
+            else:
+                import jax
 
-            program = _program(loaded, args)
-            jax.monitoring.record_event_time_span(PROGRAM_LOAD_EVENT, t0, time.time(), fun_name=name)
-            _note_used(name, key)
-            return program
+                jax.monitoring.record_event_time_span(PROGRAM_LOAD_EVENT, t0, time.time(), fun_name=name)
+                return program
     lowered = fn.lower(*args, **static)
     program, fresh = _compile_fresh(lowered, key)
     if key is not None and fresh:
         entry = _serialise(lowered, program)
-        if entry is not None and store.put(name, key, entry):
-            _note_used(name, key)
+        if entry is not None:
+            store.put(name, key, entry)
     return program
 
 
-__all__ = ["PREFETCH_MAX", "PROGRAMS_BOUND_BYTES", "TRUSTED_MODULES", "Unkeyable", "load_or_compile",
-           "prefetch_programs", "program_key", "program_store", "stable"]
+__all__ = ["PROGRAMS_BOUND_BYTES", "TRUSTED_MODULES", "Unkeyable", "load_or_compile", "program_key",
+           "program_store", "stable"]

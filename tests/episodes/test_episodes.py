@@ -65,8 +65,8 @@ def corpus_fields(bench):
     bank = bench["set"].bank
     pairs = sorted({(bank.scene_index(r["scene_id"]), bank.instance_index(r["scene_id"], r["target_id"]))
                     for r in bench["corpus"]})
-    fields = np.asarray(field_table(bank, pairs))
-    return bank, {p: fields[k] for k, p in enumerate(pairs)}
+    fields = field_table(bank, pairs)
+    return bank, {p: fields.field(k) for k, p in enumerate(pairs)}
 
 
 # ---------------------------------------------------------------------------
