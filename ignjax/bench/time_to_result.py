@@ -67,8 +67,10 @@ def _child(command: str, argv: list[str], out: Path) -> dict:
             raise SystemExit(rc)
     elif command == "in_loop":
         from ignjax.cache.compile import use_compile_cache
+        from ignjax.cache.programs import prefetch_programs
 
         use_compile_cache()
+        prefetch_programs(("in_loop", argv))
         from ignjax.bench.rollouts import in_loop_sweep
         from ignjax.episodes.dataset import load_benchmark
         from ignjax.evaluate.runner import make_world

@@ -14,8 +14,8 @@ cold, warm or off.
 """
 
 from ignjax.cache.folder import CACHE_DIR_ENV, NO_CACHE_ENV, cache_root
-from ignjax.cache.options import add_cache_arguments, apply_cache_arguments
+from ignjax.cache.options import add_cache_arguments, apply_cache_arguments, prefetch_command_programs
 from ignjax.cache.store import ArrayStore, CacheWarning, array_digest, code_digest, derived_store, digest
 
 __all__ = ["ArrayStore", "array_digest", "CACHE_DIR_ENV", "CacheWarning", "NO_CACHE_ENV", "cache_root", "code_digest",
-           "derived_store", "digest", "add_cache_arguments", "apply_cache_arguments"]
+           "derived_store", "digest", "add_cache_arguments", "apply_cache_arguments", "prefetch_command_programs"]

@@ -20,4 +20,17 @@ def apply_cache_arguments(args) -> None:
     use_compile_cache(not args.no_compile_cache)
 
 
-__all__ = ["add_cache_arguments", "apply_cache_arguments"]
+def prefetch_command_programs(command: str, args) -> int:
+    """Arm loading ahead the stored programs the last run of ``command`` with
+    the same options used (the options less ``out``, so a run written
+    elsewhere counts as the same run;
+    :func:`~ignjax.cache.programs.prefetch_programs`; the loads start once
+    the benchmark's scene files are read). Call it once JAX's runtime has
+    joined (a run of several processes) and not in a launcher. Returns how
+    many are armed."""
+    from ignjax.cache.programs import prefetch_programs
+
+    return prefetch_programs((command, sorted((k, repr(v)) for k, v in vars(args).items() if k != "out")))
+
+
+__all__ = ["add_cache_arguments", "apply_cache_arguments", "prefetch_command_programs"]

@@ -22,8 +22,9 @@ tracing:
   ``untraced``) and every leaf's type, shape, dtype, weak type and
   placement.
 
-On a hit the serialised executable is loaded (about 0.6 s for a rollout
-program); on a miss the program is lowered and compiled (through JAX's
+On a hit the serialised executable is loaded (about 1 s for a rollout
+program on the 2-core CPU, which :func:`prefetch_programs` starts ahead of
+use in a command run again); on a miss the program is lowered and compiled (through JAX's
 persistent cache) and then stored. Anything this description cannot
 vouch for is never stored: a function or a type from outside ``ignjax``
 and the libraries above (an agent written in a notebook: its source is
@@ -62,6 +63,7 @@ import numpy as np
 from ignjax.cache.clock import PROGRAM_LOAD_EVENT
 from ignjax.cache.folder import cache_root
 from ignjax.cache.store import ArrayStore, CacheWarning, array_digest, code_digest, digest
+from ignjax.fileio import atomic_write
 
 PROGRAMS_BOUND_BYTES = 2 << 30
 """Size bound of the program store (a rollout program is about 6 MB)."""
@@ -245,10 +247,14 @@ def _serialise(lowered, compiled) -> dict[str, np.ndarray] | None:
             "devices": devices, "options": np.frombuffer(options, np.uint8)}
 
 
-def _deserialise(entry: dict[str, np.ndarray], args: tuple):
-    """The program of a stored entry, loaded for the devices it was compiled
-    for and with the compile options it was compiled with (XLA:CPU finds
-    its kernels by names that depend on them: ``xla_cpu_use_fusion_emitters``)."""
+def _executable(entry: dict[str, np.ndarray]) -> tuple:
+    """The executable of a stored entry, loaded for the devices it was
+    compiled for and with the compile options it was compiled with (XLA:CPU
+    finds its kernels by names that depend on them:
+    ``xla_cpu_use_fusion_emitters``), with what :func:`_program` needs to
+    wrap it: the slow half of a load (about 1 s for a rollout program on the
+    2-core CPU, without Python's lock), which :func:`prefetch_programs` runs
+    ahead of use."""
     import jax
     from jax._src import compiler
     from jax._src.lib import xla_client as xc
@@ -270,8 +276,127 @@ def _deserialise(entry: dict[str, np.ndarray], args: tuple):
     unloaded, args_info_flat, no_kwargs = Unpickler(io.BytesIO(entry["executable"].tobytes()), backend,
                                                     devices).load()
     out_tree = pickle.load(io.BytesIO(entry["out_tree"].tobytes()))
+    return unloaded.load(), args_info_flat, no_kwargs, out_tree
+
+
+def _program(loaded: tuple, args: tuple):
+    """The compiled program of an :func:`_executable`, for arguments of its key's structure."""
+    import jax
+
+    executable, args_info_flat, no_kwargs, out_tree = loaded
     args_info = jax.tree.structure((tuple(args), {})).unflatten(args_info_flat)
-    return jax.stages.Compiled(unloaded.load(), [], args_info, out_tree, no_kwargs=no_kwargs)
+    return jax.stages.Compiled(executable, [], args_info, out_tree, no_kwargs=no_kwargs)
+
+
+PREFETCH_MAX = 8
+"""The most programs :func:`prefetch_programs` loads ahead."""
+_AHEAD_LOCK = threading.Lock()
+_AHEAD: dict = {"context": None, "used": [], "armed": [], "pending": {}, "pool": None}
+
+
+def _recent_path(store: ArrayStore, context: str):
+    return store.root / "recent" / f"{context}.json"
+
+
+def prefetch_programs(context) -> int:
+    """Arm loading ahead the stored programs that the last run with the same
+    ``context`` used (a command passes its name and options, less where it
+    writes), and record the programs this run uses under ``context`` for the
+    next. :func:`start_prefetch` then starts the loads in background threads
+    (XLA loads an executable without Python's lock, about 1 s for a rollout
+    program here), so a command run again loads its programs while it builds
+    its benchmark's tables instead of after. Only a program whose key
+    (:func:`program_key`, computed from the real arguments when the program
+    is needed) equals a loaded one's is taken from them, so a wrong guess
+    (another benchmark at the same path, other shapes) costs background work
+    and never a result; the outputs are the same bytes either way.
+
+    Returns:
+        How many programs are armed (0 when the store is off or the context
+        has no record).
+    """
+    store = program_store()
+    if store is None:
+        return 0
+    ctx = digest("prefetch", context)
+    try:
+        recent = json.loads(_recent_path(store, ctx).read_text())["programs"][:PREFETCH_MAX]
+        recent = [(str(n), str(k)) for n, k in recent]
+    except (OSError, ValueError, KeyError, TypeError):
+        recent = []
+    with _AHEAD_LOCK:
+        _AHEAD.update(context=ctx, used=[], armed=recent, pending={})
+    return len(recent)
+
+
+def start_prefetch() -> int:
+    """Start the loads :func:`prefetch_programs` armed (once; later calls
+    start nothing). :func:`ignjax.episodes.dataset.open_benchmark` calls it
+    once its scene files are read: a load in a background thread must not
+    run while the main thread first imports USD, whose libraries take
+    Python's lock while the dynamic loader's is held (a deadlock, reproduced
+    under load with the loads started at a command's start). Returns how many
+    started."""
+    store = program_store()
+    with _AHEAD_LOCK:
+        todo, _AHEAD["armed"] = _AHEAD["armed"], []
+    if not todo or store is None:
+        return 0
+    import jax
+    from concurrent.futures import ThreadPoolExecutor
+
+    from ignjax.devices import available_cores
+
+    jax.local_devices()  # the backend starts here, not in a worker
+
+    def load(name: str, key: str):
+        entry = store.get(name, key)
+        return None if entry is None else _executable(entry)
+
+    with _AHEAD_LOCK:
+        if _AHEAD["pool"] is None:
+            _AHEAD["pool"] = ThreadPoolExecutor(max(1, available_cores()), thread_name_prefix="ignjax-prefetch")
+        for name, key in todo:
+            _AHEAD["pending"][key] = _AHEAD["pool"].submit(load, name, key)
+    return len(todo)
+
+
+def settle_prefetch() -> None:
+    """Wait for every load :func:`start_prefetch` started, so that none runs
+    past the loading of a benchmark or the first program's use (the imports
+    that come later: :func:`start_prefetch`'s reason).
+    :meth:`ignjax.episodes.dataset.BenchmarkScenes.with_fields` calls it."""
+    with _AHEAD_LOCK:
+        pending = list(_AHEAD["pending"].values())
+    for f in pending:
+        f.exception()  # waits; a failed or unused guess is only left unused
+
+
+def _take_prefetched(key: str):
+    """The :func:`_executable` loaded ahead under ``key``, or None, once every load started ahead has ended."""
+    with _AHEAD_LOCK:
+        fut = _AHEAD["pending"].pop(key, None)
+    settle_prefetch()
+    if fut is None:
+        return None
+    try:
+        return fut.result()
+    except Exception:  # noqa: BLE001 - an entry that did not load is loaded (or compiled) the usual way
+        return None
+
+
+def _note_used(name: str, key: str) -> None:
+    """Add a program to the record of this run's context (:func:`prefetch_programs`)."""
+    store = program_store()
+    with _AHEAD_LOCK:
+        ctx, used = _AHEAD["context"], _AHEAD["used"]
+        if ctx is None or store is None or [name, key] in used:
+            return
+        used.append([name, key])
+        try:
+            atomic_write(_recent_path(store, ctx), json.dumps({"programs": used}))
+        except OSError:
+            pass  # the store's own writes warn when the folder cannot be written
 
 
 _THREAD = threading.local()
@@ -337,27 +462,30 @@ def load_or_compile(fn, args: tuple, static: dict, name: str, context=()):
     store = program_store()
     key = program_key(fn, args, static, context) if store is not None else None
     if key is not None:
-        entry = store.get(name, key)
+        t0 = time.time()
+        loaded = _take_prefetched(key)
+        entry = store.get(name, key) if loaded is None else None
         if entry is not None:
-            t0 = time.time()
             try:
-                program = _deserialise(entry, args)
+                loaded = _executable(entry)
             except Exception as e:  # noqa: BLE001 - an entry that will not load is compiled again
                 warnings.warn(f"ignjax cache: a stored program in {store.path(name, key)} does not load "
                               f"({type(e).__name__}); compiling it again", CacheWarning, stacklevel=2)
-            else:
-                import jax
+        if loaded is not None:
+            import jax
 
-                jax.monitoring.record_event_time_span(PROGRAM_LOAD_EVENT, t0, time.time(), fun_name=name)
-                return program
+            program = _program(loaded, args)
+            jax.monitoring.record_event_time_span(PROGRAM_LOAD_EVENT, t0, time.time(), fun_name=name)
+            _note_used(name, key)
+            return program
     lowered = fn.lower(*args, **static)
     program, fresh = _compile_fresh(lowered, key)
     if key is not None and fresh:
         entry = _serialise(lowered, program)
-        if entry is not None:
-            store.put(name, key, entry)
+        if entry is not None and store.put(name, key, entry):
+            _note_used(name, key)
     return program
 
 
-__all__ = ["PROGRAMS_BOUND_BYTES", "TRUSTED_MODULES", "Unkeyable", "load_or_compile", "program_key",
-           "program_store", "stable"]
+__all__ = ["PREFETCH_MAX", "PROGRAMS_BOUND_BYTES", "TRUSTED_MODULES", "Unkeyable", "load_or_compile",
+           "prefetch_programs", "program_key", "program_store", "settle_prefetch", "stable", "start_prefetch"]

@@ -30,6 +30,7 @@ import numpy as np
 
 from ignjax.arrays import on_device, take_rows
 from ignjax.cache.clock import in_phase
+from ignjax.cache.programs import settle_prefetch, start_prefetch
 from ignjax.devices import available_cores
 from ignjax.episodes.difficulty import BIN_INDEX
 from ignjax.episodes.schema import read_episodes
@@ -238,6 +239,7 @@ def open_benchmark(path: str | os.PathLike, scenes_root: str | os.PathLike | Non
     # each result is the same whichever thread makes it, and errors come in the files' path order
     with ThreadPoolExecutor(max(1, available_cores())) as pool:
         futures = [pool.submit(prepare, scene) for item in files for scene in read(item)]
+        start_prefetch()  # the scene files are read (USD imported): programs armed ahead may load now
         done = [f.result() for f in futures]
     if not done:
         raise EpisodeError(p, "episodes", "no episodes to run (the file, cut by limit / indices, is empty)")
@@ -372,6 +374,7 @@ class BenchmarkScenes:
         for k in np.flatnonzero(~np.isfinite(at_start))[:1]:
             raise EpisodeError(es.path, f"episode {records[k]['episode_id']}: start",
                                "the target cannot be reached from the start pose")
+        settle_prefetch()  # no program loaded ahead runs past the loading (ignjax.cache.programs.start_prefetch)
         return dataclasses.replace(es, fields=jax.device_put(fields))
 
 

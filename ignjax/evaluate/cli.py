@@ -79,7 +79,7 @@ from pathlib import Path
 import numpy as np
 
 from ignjax.arrays import parse_assignment, parse_floats
-from ignjax.cache import add_cache_arguments, apply_cache_arguments
+from ignjax.cache import add_cache_arguments, apply_cache_arguments, prefetch_command_programs
 from ignjax.devices import processes as PR
 from ignjax import __version__
 from ignjax.data.shipped import shipped_episodes
@@ -262,6 +262,7 @@ def main(argv=None) -> int:
             return launch("ignjax.evaluate", argv, popts.launch)
         # JAX's runtime joins before the settings are read (reading them may run JAX code)
         group = PR.start(popts)
+        prefetch_command_programs("evaluate", args)
         return run(args, check_settings(args, popts), popts, group)
     except IgnjaxError as e:
         print(f"error: {e}", file=sys.stderr)

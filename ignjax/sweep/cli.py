@@ -15,7 +15,7 @@ import sys
 import time
 from pathlib import Path
 
-from ignjax.cache import add_cache_arguments, apply_cache_arguments
+from ignjax.cache import add_cache_arguments, apply_cache_arguments, prefetch_command_programs
 from ignjax.devices import processes as PR
 from ignjax.errors import ConfigError, IgnjaxError
 
@@ -102,6 +102,8 @@ def main(argv=None) -> int:
             return launch("ignjax.sweep", argv, popts.launch)
         from ignjax.evaluate.recovery import report_model_failures
         from ignjax.sweep.stages import model_failures, run_sweep
+
+        prefetch_command_programs("sweep", args)
 
         t0 = time.perf_counter()
         results = run_sweep(cfg, studies, out, resume=args.resume, force=args.force, quiet=args.quiet, group=group)

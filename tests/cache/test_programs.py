@@ -153,6 +153,42 @@ def test_jax_cache_entries_of_stored_programs_are_their_own(store):
     assert not list((store.root / "scaled").glob("*.npz"))
 
 
+def test_a_run_again_loads_its_programs_ahead_and_the_same_bytes(store, monkeypatch):
+    """prefetch_programs / start_prefetch: the programs the last run of a
+    context used are armed in the next and load once started; one is used
+    only where its key is asked for, every load has ended by the first use,
+    and a wrong guess or a damaged record falls back to the usual path."""
+    monkeypatch.setattr(PR, "_AHEAD", {"context": None, "used": [], "armed": [], "pending": {}, "pool": None})
+    args, n = _args(5), N + 20  # a program no earlier test compiled
+    assert PR.prefetch_programs(("run", n)) == 0  # nothing recorded yet
+    first = PR.load_or_compile(_scaled, args, {"n": n}, "scaled")  # compiled, stored and recorded
+    records = list((store.root / "recent").glob("*.json"))
+    assert len(records) == 1
+    jax.clear_caches()  # as in a new process
+    assert PR.prefetch_programs(("run", n)) == 1
+    assert PR.prefetch_programs(("another run", n)) == 0  # another context: its own record (none)
+    assert PR.start_prefetch() == 0 and not PR._AHEAD["pending"]
+    assert PR.prefetch_programs(("run", n)) == 1 and not PR._AHEAD["pending"]  # armed, not started
+    assert PR.start_prefetch() == 1 and PR.start_prefetch() == 0  # started once
+    (ahead,) = PR._AHEAD["pending"].values()
+    assert ahead.result() is not None  # loaded in the background
+    clock = CompileClock().start()
+    again = PR.load_or_compile(_scaled, args, {"n": n}, "scaled")
+    clock.stop()
+    assert clock.whole == 1 and clock.programs == 1 and not PR._AHEAD["pending"]
+    chex.assert_trees_all_equal(jax.device_get(first(*args)), jax.device_get(again(*args)))
+    # a guess that does not fit (other shapes under the same context) is never used: that call compiles
+    jax.clear_caches()
+    PR.prefetch_programs(("run", n))
+    PR.start_prefetch()
+    other = PR.load_or_compile(_scaled, _args(7), {"n": n}, "scaled")
+    assert np.asarray(other(*_args(7))["sum"]).tolist() == [n * k + 1.0 for k in range(7)]
+    (guess,) = PR._AHEAD["pending"].values()
+    assert guess.done()  # waited for at the first use: no load runs past it; the guess stays unused
+    records[0].write_text("{not json")  # a damaged record: nothing ahead, no error
+    assert PR.prefetch_programs(("run", n)) == 0
+
+
 def test_the_store_is_off_with_the_compilation_cache(store):
     was = jax.config.jax_enable_compilation_cache
     jax.config.update("jax_enable_compilation_cache", False)  # what --no-compile-cache does
