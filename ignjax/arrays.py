@@ -6,6 +6,7 @@ vectors parsed from command-line text."""
 from __future__ import annotations
 
 import dataclasses
+import mmap
 import tomllib
 from typing import Any
 
@@ -57,6 +58,32 @@ def xp(*arrays):
     """
     host = (np.ndarray, np.generic, int, float, tuple, list)
     return np if all(isinstance(a, host) for a in arrays) else jnp
+
+
+DEVICE_ALIGN = 64
+"""Byte alignment at which a CPU device takes a host array as its buffer without a copy."""
+
+HUGE_PAGES_FROM = 4 << 20
+"""Size from which :func:`host_empty` asks the kernel for huge pages."""
+
+
+def host_empty(shape, dtype) -> np.ndarray:
+    """An uninitialised host array whose data is :data:`DEVICE_ALIGN`-byte
+    aligned. ``jax.device_put`` gives CPU devices such an array itself as
+    their buffer (on every device of a replicated placement) instead of a
+    copy, so the large tables of a benchmark (the scene bank's ray grids,
+    the goal fields) are built once in memory and never copied to the
+    devices. Elsewhere it is an ordinary array. The array must not be
+    written after it is put on a device."""
+    dtype = np.dtype(dtype)
+    n = int(np.prod(shape, dtype=np.int64)) * dtype.itemsize
+    if n >= HUGE_PAGES_FROM and hasattr(mmap, "MADV_HUGEPAGE"):
+        pages = mmap.mmap(-1, n)  # page-aligned; freed with the last array that views it
+        pages.madvise(mmap.MADV_HUGEPAGE)
+        return np.frombuffer(pages, np.uint8, n).view(dtype).reshape(shape)
+    raw = np.empty(n + DEVICE_ALIGN, np.uint8)
+    skip = -raw.ctypes.data % DEVICE_ALIGN
+    return raw[skip:skip + n].view(dtype).reshape(shape)
 
 
 def on_device(x, dtype=None) -> jax.Array:

@@ -147,4 +147,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from ignjax.devices.quickexit import exit_now
+
+    exit_now(main())  # as the commands' entry points end (ignjax.devices.quickexit)

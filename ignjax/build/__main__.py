@@ -1,11 +1,10 @@
 """``python -m ignjax.build``."""
 
-import sys
-
 from ignjax.scenes.viz import headless_gl
 
 headless_gl()  # before anything imports mujoco
 
 from ignjax.build.cli import main  # noqa: E402
+from ignjax.devices.quickexit import exit_now  # noqa: E402
 
-sys.exit(main())
+exit_now(main())  # without Python's teardown (ignjax.devices.quickexit)

@@ -299,20 +299,20 @@ def _recent_path(store: ArrayStore, context: str):
 
 
 def prefetch_programs(context) -> int:
-    """Arm loading ahead the stored programs that the last run with the same
+    """Load ahead the stored programs that the last run with the same
     ``context`` used (a command passes its name and options, less where it
     writes), and record the programs this run uses under ``context`` for the
-    next. :func:`start_prefetch` then starts the loads in background threads
-    (XLA loads an executable without Python's lock, about 1 s for a rollout
-    program here), so a command run again loads its programs while it builds
-    its benchmark's tables instead of after. Only a program whose key
+    next. The loads start at once in background threads (:func:`start_prefetch`;
+    XLA loads an executable without Python's lock, 1-2 s for a rollout
+    program here), so a command run again loads its programs while it imports
+    its modules and builds its benchmark's tables instead of after. Only a program whose key
     (:func:`program_key`, computed from the real arguments when the program
     is needed) equals a loaded one's is taken from them, so a wrong guess
     (another benchmark at the same path, other shapes) costs background work
     and never a result; the outputs are the same bytes either way.
 
     Returns:
-        How many programs are armed (0 when the store is off or the context
+        How many loads started (0 when the store is off or the context
         has no record).
     """
     store = program_store()
@@ -326,17 +326,17 @@ def prefetch_programs(context) -> int:
         recent = []
     with _AHEAD_LOCK:
         _AHEAD.update(context=ctx, used=[], armed=recent, pending={})
-    return len(recent)
+    return start_prefetch()
 
 
 def start_prefetch() -> int:
     """Start the loads :func:`prefetch_programs` armed (once; later calls
-    start nothing). :func:`ignjax.episodes.dataset.open_benchmark` calls it
-    once its scene files are read: a load in a background thread must not
-    run while the main thread first imports USD, whose libraries take
-    Python's lock while the dynamic loader's is held (a deadlock, reproduced
-    under load with the loads started at a command's start). Returns how many
-    started."""
+    start nothing). A load in a background thread must not run while the
+    main thread first imports USD, whose libraries take Python's lock while
+    the dynamic loader's is held (a deadlock, reproduced under load):
+    :mod:`ignjax.scenes.io.usd` waits for the loads (:func:`settle_prefetch`)
+    before it imports them, which a run whose scene files are all remembered
+    (:mod:`ignjax.scenes.io.remembered`) never does. Returns how many started."""
     store = program_store()
     with _AHEAD_LOCK:
         todo, _AHEAD["armed"] = _AHEAD["armed"], []
@@ -363,9 +363,10 @@ def start_prefetch() -> int:
 
 def settle_prefetch() -> None:
     """Wait for every load :func:`start_prefetch` started, so that none runs
-    past the loading of a benchmark or the first program's use (the imports
-    that come later: :func:`start_prefetch`'s reason).
-    :meth:`ignjax.episodes.dataset.BenchmarkScenes.with_fields` calls it."""
+    past the loading of a benchmark, the first program's use or an import
+    of USD (:func:`start_prefetch`'s reason).
+    :meth:`ignjax.episodes.dataset.BenchmarkScenes.with_fields` and
+    :mod:`ignjax.scenes.io.usd` call it."""
     with _AHEAD_LOCK:
         pending = list(_AHEAD["pending"].values())
     for f in pending:

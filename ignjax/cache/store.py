@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ignjax.cache.folder import cache_root
+from ignjax.cache.npz import read_npz
 from ignjax.fileio import atomic_write
 
 FORMAT = 3
@@ -121,8 +122,7 @@ class ArrayStore:
         """The arrays stored under ``key``, or None (absent or damaged)."""
         p = self.path(kind, key)
         try:
-            with np.load(p, allow_pickle=False) as z:
-                arrays = {n: z[n] for n in z.files}
+            arrays = read_npz(p)
         except (FileNotFoundError, NotADirectoryError):
             return None
         except Exception as e:  # noqa: BLE001 - a damaged file of any kind is a miss

@@ -30,7 +30,7 @@ import numpy as np
 
 from ignjax.arrays import on_device, take_rows
 from ignjax.cache.clock import in_phase
-from ignjax.cache.programs import settle_prefetch, start_prefetch
+from ignjax.cache.programs import settle_prefetch
 from ignjax.devices import available_cores
 from ignjax.episodes.difficulty import BIN_INDEX
 from ignjax.episodes.schema import read_episodes
@@ -239,7 +239,6 @@ def open_benchmark(path: str | os.PathLike, scenes_root: str | os.PathLike | Non
     # each result is the same whichever thread makes it, and errors come in the files' path order
     with ThreadPoolExecutor(max(1, available_cores())) as pool:
         futures = [pool.submit(prepare, scene) for item in files for scene in read(item)]
-        start_prefetch()  # the scene files are read (USD imported): programs armed ahead may load now
         done = [f.result() for f in futures]
     if not done:
         raise EpisodeError(p, "episodes", "no episodes to run (the file, cut by limit / indices, is empty)")

@@ -27,7 +27,7 @@ from typing import Sequence
 import jax
 import numpy as np
 
-from ignjax.arrays import pytree_dataclass, xp
+from ignjax.arrays import host_empty, pytree_dataclass, xp
 from ignjax.errors import ConfigError
 
 MAX_CELLS = 2**31 - 1
@@ -122,7 +122,7 @@ class FieldTable:
     def of(cls, fields: Sequence[np.ndarray], shape: tuple[int, int]) -> "FieldTable":
         """A host table (numpy leaves) of fields given at their own extents."""
         start, ext, n = cls.layout([np.shape(f) for f in fields], shape)
-        values = np.empty(n, np.float32)
+        values = host_empty(n, np.float32)  # shared with CPU devices, not copied (ignjax.arrays.host_empty)
         end = int(start[-1]) + int(ext[-1, 0] * ext[-1, 1]) if len(fields) else 0
         values[end:] = np.inf
         for s, f in zip(start, fields):

@@ -13,7 +13,7 @@ import jax
 import mujoco
 import numpy as np
 
-from ignjax.arrays import on_device, pytree_dataclass
+from ignjax.arrays import host_empty, on_device, pytree_dataclass
 from ignjax.scenes.navgrid import NavGrid
 from ignjax.scenes.voxels import N_PRIM_COLUMNS
 
@@ -116,7 +116,8 @@ def stack_ray_arrays(arrays: Sequence[dict[str, np.ndarray]]) -> dict[str, np.nd
     for name in _PAD_VALUES:
         items = [a[name] for a in arrays]
         shape = tuple(max(s) for s in zip(*[x.shape for x in items]))
-        stacked = np.full((len(items),) + shape, _PAD_VALUES[name], dtype=items[0].dtype)
+        stacked = host_empty((len(items),) + shape, items[0].dtype)  # shared with CPU devices, not copied
+        stacked.fill(_PAD_VALUES[name])
         for i, x in enumerate(items):
             stacked[(i,) + tuple(slice(0, n) for n in x.shape)] = x
         out[name] = stacked

@@ -221,7 +221,7 @@ def replicate_world(world: World, mesh: Mesh) -> World:
     and mesh and dropped with the world: the scene bank is large (about half
     a gigabyte for the shipped benchmark), and copying it to the devices on
     every call would cost a good part of a batch's time. Each device holds
-    its own copy, CPU devices too. A world of shapes
+    its own copy; CPU devices share one (:func:`_shared_on_cpu`). A world of shapes
     (:func:`ignjax.sim.world.world_shapes`) gets the copies' placement."""
     if mesh.size == 1 or any(isinstance(x, jax.core.Tracer) for x in jax.tree.leaves(world)):
         return world
@@ -233,9 +233,20 @@ def replicate_world(world: World, mesh: Mesh) -> World:
     hit = _REPLICAS.get(key)
     if hit is not None and hit[0]() is world:
         return hit[1]
-    copy = jax.device_put(world, NamedSharding(mesh, P()))
+    copy = jax.device_put(_shared_on_cpu(world, mesh), NamedSharding(mesh, P()))
     _REPLICAS[key] = (weakref.ref(world, lambda _, k=key: _REPLICAS.pop(k, None)), copy)
     return copy
+
+
+def _shared_on_cpu(world: World, mesh: Mesh) -> World:
+    """On CPU devices, ``world``'s arrays as host views of their buffers, which
+    ``jax.device_put`` then shares with every device of the mesh instead of
+    copying (CPU devices alias host memory that is 64-byte aligned, as device
+    buffers are): the copies share one memory, so half a gigabyte per device
+    is neither allocated nor written. Elsewhere ``world`` itself."""
+    if any(d.platform != "cpu" for d in mesh.devices.flat):
+        return world
+    return jax.tree.map(lambda x: np.asarray(x) if isinstance(x, jax.Array) and not x.weak_type else x, world)
 
 
 def _sharded_args(fn, world, specs, agent, params, keys, chunk, parts: int, copies: int, out_axis: int):

@@ -1,7 +1,5 @@
 """``python -m ignjax.sweep``."""
 
-import sys
-
 from ignjax.scenes.viz import headless_gl
 
 headless_gl()  # before anything imports mujoco: headless EGL where it is installed and MUJOCO_GL is unset
@@ -11,5 +9,6 @@ from ignjax.devices import configure_cpu_devices  # noqa: E402
 configure_cpu_devices()  # before JAX starts: one CPU device per core (IGNJAX_CPU_DEVICES overrides)
 
 from ignjax.sweep.cli import main  # noqa: E402
+from ignjax.devices.quickexit import exit_now  # noqa: E402
 
-sys.exit(main())
+exit_now(main())  # without Python's teardown (ignjax.devices.quickexit)

@@ -47,9 +47,14 @@ def test_entry_round_trip_and_damage_is_a_miss(tmp_path):
     with pytest.warns(CacheWarning, match="damaged"):
         assert store.get("k", "x") is None
     flipped = bytearray(whole)
-    at = whole.index(np.arange(12, dtype=np.float32).tobytes())  # inside array a's data: the zip's CRC fails
+    at = whole.index(np.arange(12, dtype=np.float32).tobytes())  # inside array a's data: its checksum fails
     flipped[at + 5] ^= 0xFF
     p.write_bytes(bytes(flipped))
+    with pytest.warns(CacheWarning, match="checksum"):
+        assert store.get("k", "x") is None
+    compressed = tmp_path / "compressed.npz"  # not what the store writes: a damaged entry, never read
+    np.savez_compressed(compressed, **{n: np.asarray(a) for n, a in arrays.items()})
+    p.write_bytes(compressed.read_bytes())
     with pytest.warns(CacheWarning, match="damaged"):
         assert store.get("k", "x") is None
     p.write_bytes(whole)

@@ -155,9 +155,9 @@ def test_jax_cache_entries_of_stored_programs_are_their_own(store):
 
 def test_a_run_again_loads_its_programs_ahead_and_the_same_bytes(store, monkeypatch):
     """prefetch_programs / start_prefetch: the programs the last run of a
-    context used are armed in the next and load once started; one is used
-    only where its key is asked for, every load has ended by the first use,
-    and a wrong guess or a damaged record falls back to the usual path."""
+    context used start loading in the next at once; one is used only where
+    its key is asked for, every load has ended by the first use, and a wrong
+    guess or a damaged record falls back to the usual path."""
     monkeypatch.setattr(PR, "_AHEAD", {"context": None, "used": [], "armed": [], "pending": {}, "pool": None})
     args, n = _args(5), N + 20  # a program no earlier test compiled
     assert PR.prefetch_programs(("run", n)) == 0  # nothing recorded yet
@@ -165,11 +165,10 @@ def test_a_run_again_loads_its_programs_ahead_and_the_same_bytes(store, monkeypa
     records = list((store.root / "recent").glob("*.json"))
     assert len(records) == 1
     jax.clear_caches()  # as in a new process
-    assert PR.prefetch_programs(("run", n)) == 1
     assert PR.prefetch_programs(("another run", n)) == 0  # another context: its own record (none)
-    assert PR.start_prefetch() == 0 and not PR._AHEAD["pending"]
-    assert PR.prefetch_programs(("run", n)) == 1 and not PR._AHEAD["pending"]  # armed, not started
-    assert PR.start_prefetch() == 1 and PR.start_prefetch() == 0  # started once
+    assert not PR._AHEAD["pending"]
+    assert PR.prefetch_programs(("run", n)) == 1 and len(PR._AHEAD["pending"]) == 1  # loading at once
+    assert PR.start_prefetch() == 0  # started once
     (ahead,) = PR._AHEAD["pending"].values()
     assert ahead.result() is not None  # loaded in the background
     clock = CompileClock().start()
@@ -179,8 +178,7 @@ def test_a_run_again_loads_its_programs_ahead_and_the_same_bytes(store, monkeypa
     chex.assert_trees_all_equal(jax.device_get(first(*args)), jax.device_get(again(*args)))
     # a guess that does not fit (other shapes under the same context) is never used: that call compiles
     jax.clear_caches()
-    PR.prefetch_programs(("run", n))
-    PR.start_prefetch()
+    assert PR.prefetch_programs(("run", n)) == 1
     other = PR.load_or_compile(_scaled, _args(7), {"n": n}, "scaled")
     assert np.asarray(other(*_args(7))["sum"]).tolist() == [n * k + 1.0 for k in range(7)]
     (guess,) = PR._AHEAD["pending"].values()
@@ -217,3 +215,32 @@ def test_a_rollout_program_key_ignores_the_host_side_scenes_only(small_benchmark
     assert key != PR.program_key(R._run_sharded, args, dict(static, agent=get_agent("eig")))
     text = R._run_sharded.lower(*args, **static).as_text()
     assert text == R._run_sharded.lower(*bare, **static).as_text()
+
+
+def test_usd_libraries_load_only_once_the_loads_ahead_have_ended():
+    """start_prefetch's guard: ignjax.scenes.io.usd waits for every load in flight before USD's
+    libraries load (they take Python's lock under the dynamic loader's; a load running beside them
+    deadlocked). A fresh process, so that USD is not imported yet."""
+    import subprocess
+    import sys
+    import textwrap
+
+    script = textwrap.dedent("""
+        import sys, threading, time
+        from concurrent.futures import ThreadPoolExecutor
+        from ignjax.cache import programs as PR
+        assert "pxr" not in sys.modules
+        started = threading.Event()
+        def load():
+            started.set()
+            time.sleep(1.0)
+            return "pxr" in sys.modules
+        with PR._AHEAD_LOCK:
+            PR._AHEAD["pending"]["a load in flight"] = ahead = ThreadPoolExecutor(1).submit(load)
+        started.wait()
+        import ignjax.scenes.io.usd
+        assert "pxr" in sys.modules and ahead.done() and ahead.result() is False
+        print("ok")
+    """)
+    p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0 and p.stdout.strip() == "ok", p.stderr[-2000:]

@@ -148,9 +148,12 @@ def scene_sources(paths, map_=map) -> list[tuple[object, Path]]:
 
 
 def _read_usd(p: Path) -> list[Scene]:
-    from ignjax.scenes.io.usd.load import read_usd
+    def read():  # USD's libraries (about 0.3 s to load) only when the file is read, not when it is remembered
+        from ignjax.scenes.io.usd.load import read_usd
 
-    return [read_remembered(p, "usd", lambda: read_usd(p), _USD_VERSION)]
+        return read_usd(p)
+
+    return [read_remembered(p, "usd", read, _USD_VERSION)]
 
 
 def _read_mesh(p: Path) -> list[Scene]:

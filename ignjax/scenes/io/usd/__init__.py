@@ -28,7 +28,11 @@ Modules
     ===============  ======================================================
 """
 
-from ignjax.scenes.io.formats import USD_SUFFIXES
+from ignjax.cache.programs import settle_prefetch
+
+settle_prefetch()  # no program may load ahead while USD's libraries load (ignjax.cache.programs.start_prefetch)
+
+from ignjax.scenes.io.formats import USD_SUFFIXES  # noqa: E402
 from ignjax.scenes.io.usd.export import USD_FORMAT, USD_FORMAT_VERSION, save_usd, scene_to_stage
 from ignjax.scenes.io.usd.load import load_usd
 from ignjax.scenes.io.usd.mesh import triangulate_faces
