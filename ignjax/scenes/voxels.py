@@ -45,7 +45,6 @@ import math
 
 import mujoco
 import numpy as np
-from scipy import ndimage
 
 from ignjax.arrays import ragged_index
 from ignjax.scenes.model import Scene
@@ -335,6 +334,7 @@ def _watertight(faces: np.ndarray) -> bool:
 
 def _fill_inside(vox: np.ndarray) -> np.ndarray:
     """Fill the enclosed interior of a voxelized closed surface."""
+    from scipy import ndimage  # here, not at import: a warm run reads its grids from the cache
     if len(vox) == 0:
         return vox
     lo = vox.min(0)
@@ -521,6 +521,7 @@ def march_codes(occupied: np.ndarray, touched: np.ndarray, full: np.ndarray) -> 
         touched: (Z, H, W) bool, geometry overlaps or touches it.
         full: (Z, H, W) bool, the voxel lies inside one primitive.
     """
+    from scipy import ndimage  # here, not at import: a warm run reads its grids from the cache (0.27 s)
     touched = touched | occupied
     if touched.any():
         cheb = ndimage.distance_transform_cdt(~touched, metric="chessboard")
