@@ -17,7 +17,7 @@ from ignjax.cache.npz import NpzError, read_npz
 def test_host_empty_is_aligned_writable_and_of_its_shape(shape, dtype):
     a = host_empty(shape, dtype)
     assert a.shape == shape and a.dtype == np.dtype(dtype) and a.flags.writeable and a.flags.c_contiguous
-    assert a.ctypes.data % DEVICE_ALIGN == 0
+    assert a.ctypes.data % DEVICE_ALIGN == 0 or a.size == 0  # an empty array has no data to align
     a.fill(1)
     assert int(a.sum()) == a.size
 

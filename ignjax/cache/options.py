@@ -21,13 +21,13 @@ def apply_cache_arguments(args) -> None:
 
 
 def prefetch_command_programs(command: str, args) -> int:
-    """Arm loading ahead the stored programs the last run of ``command`` with
-    the same options used (the options less ``out``, so a run written
+    """Start loading ahead the stored programs the last run of ``command``
+    with the same options used (the options less ``out``, so a run written
     elsewhere counts as the same run;
-    :func:`~ignjax.cache.programs.prefetch_programs`; the loads start once
-    the benchmark's scene files are read). Call it once JAX's runtime has
+    :func:`~ignjax.cache.programs.prefetch_programs`: the loads run in
+    background threads from this call on). Call it once JAX's runtime has
     joined (a run of several processes) and not in a launcher. Returns how
-    many are armed."""
+    many loads started."""
     from ignjax.cache.programs import prefetch_programs
 
     return prefetch_programs((command, sorted((k, repr(v)) for k, v in vars(args).items() if k != "out")))
