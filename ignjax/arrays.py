@@ -79,7 +79,10 @@ def host_empty(shape, dtype) -> np.ndarray:
     n = int(np.prod(shape, dtype=np.int64)) * dtype.itemsize
     if n >= HUGE_PAGES_FROM and hasattr(mmap, "MADV_HUGEPAGE"):
         pages = mmap.mmap(-1, n)  # page-aligned; freed with the last array that views it
-        pages.madvise(mmap.MADV_HUGEPAGE)
+        try:
+            pages.madvise(mmap.MADV_HUGEPAGE)
+        except OSError:  # a kernel without transparent huge pages: ordinary pages
+            pass
         return np.frombuffer(pages, np.uint8, n).view(dtype).reshape(shape)
     raw = np.empty(n + DEVICE_ALIGN, np.uint8)
     skip = -raw.ctypes.data % DEVICE_ALIGN
