@@ -63,7 +63,7 @@ def even_chunk(n_rows: int, chunk: int) -> int:
     return chunk
 
 
-def masked_map(fn, mask, args, default, chunk: int | None = None):
+def masked_map(fn, mask, args, default, chunk: int | None = None, gather_back: bool = False):
     """``where(mask, vmap(fn)(args), default)``, computing ``fn`` on the selected rows only.
 
     Args:
@@ -73,6 +73,18 @@ def masked_map(fn, mask, args, default, chunk: int | None = None):
         default: pytree with leading axis B: the result on unselected rows
             (and its dtypes are the result's).
         chunk: rows per vectorised call (static); default :func:`chunk_size`.
+        gather_back: how the results reach their rows (the same values
+            either way). False: each chunk's rows are written into
+            ``default`` inside the loop (an indexed write, which XLA:CPU runs
+            as a loop of one trip per row: cheap, and nothing is done for the
+            rows not selected). True: each chunk's results go to a packed
+            buffer, one contiguous block per chunk, and every row takes its
+            result from there (by its rank in the selection) or from
+            ``default`` in one gather and select after the loop: work for
+            every row, but no write into ``default`` in the loop. Which is
+            faster depends on the program around it (in the rollouts, the
+            observation's update is faster gathered back and the ray passes
+            are not; ``docs/performance.md``).
 
     Returns:
         A pytree like ``default``.
@@ -85,15 +97,26 @@ def masked_map(fn, mask, args, default, chunk: int | None = None):
     trips = (n_sel + c - 1) // c
     row_fn = jax.vmap(fn)
 
-    def body(i, out):
+    def chunk_of(i):  # chunk i's rows (B past the selection) and their results
         rows = jax.lax.dynamic_slice(idx, (i * c,), (c,))
-        take = jnp.minimum(rows, B - 1)
-        vals = row_fn(jax.tree.map(lambda a: a[take], args))
-        return jax.tree.map(
-            lambda o, v: o.at[rows].set(v.astype(o.dtype), mode="drop", indices_are_sorted=True),
-            out, vals)
+        return rows, row_fn(jax.tree.map(lambda a: a[jnp.minimum(rows, B - 1)], args))
 
-    return jax.lax.fori_loop(0, trips, body, default)
+    if not gather_back:
+        def write(i, out):
+            rows, vals = chunk_of(i)
+            return jax.tree.map(lambda o, v: o.at[rows].set(v.astype(o.dtype), mode="drop", indices_are_sorted=True),
+                                out, vals)
+
+        return jax.lax.fori_loop(0, trips, write, default)
+
+    def pack(i, out):
+        vals = chunk_of(i)[1]
+        return jax.tree.map(lambda o, v: jax.lax.dynamic_update_slice_in_dim(o, v.astype(o.dtype), i * c, 0), out, vals)
+
+    packed = jax.lax.fori_loop(0, trips, pack, jax.tree.map(lambda d: jnp.zeros((n_chunks * c,) + d.shape[1:], d.dtype),
+                                                             default))
+    rank = jnp.maximum(jnp.cumsum(mask.astype(jnp.int32)) - 1, 0)  # a selected row's place in the selection
+    return jax.tree.map(lambda p, d: jnp.where(mask.reshape((B,) + (1,) * (d.ndim - 1)), p[rank], d), packed, default)
 
 
 def first_equal(keys, mask):

@@ -268,5 +268,6 @@ def observe_batch(world: World, states: T.SimState, previous: T.Observation, mov
     rays and sight lines of the moved rows are marched together first (:func:`sight_batch`).
     Row for row the same as ``vmap(observe)``."""
     sight = sight_batch(world, states, moved, chunk)
-    obs = masked_map(lambda a: observe(world, *a), moved, (states, sight), previous, chunk)
+    # gathered back: faster here than writing into ``previous`` in the loop (docs/performance.md)
+    obs = masked_map(lambda a: observe(world, *a), moved, (states, sight), previous, chunk, gather_back=True)
     return dataclasses.replace(obs, **jax.vmap(lambda st: state_fields(world, st))(states))
