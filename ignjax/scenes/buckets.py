@@ -12,7 +12,8 @@ evaluation then builds one bucket's bank at a time
 
 :func:`padded_bytes` is the estimate the plan uses: the bytes of the tables
 that grow with a scene's grid (the ray caster's voxel and segment tables,
-primitives, the navigation grid tables), ``per_cell`` more bytes per
+primitives, the navigation grid tables, the simulator's occupancy columns
+packed from the voxels), ``per_cell`` more bytes per
 navigation cell for what the caller derives from the grid (the simulator's
 probe maps), and each scene's goal fields of 4 bytes a cell of the scene's
 own grid (:class:`~ignjax.scenes.fieldtable.FieldTable`). The small
@@ -28,16 +29,19 @@ import numpy as np
 from ignjax.errors import ConfigError
 from ignjax.scenes.fieldtable import padded_cells
 from ignjax.scenes.navgrid import NavGrid
-from ignjax.scenes.raygrid import ray_grid_arrays
+from ignjax.scenes.raygrid import COLUMN_WORD_BITS, ray_grid_arrays
 
 GRID_TABLE_BYTES = 9
 """Bytes a navigation cell takes in the bank's grid table: navigable (1), room (4), component (4)."""
 
 
 def _table_shapes(grid: NavGrid) -> dict[str, tuple[tuple[int, ...], int]]:
-    """name -> (shape, item size) of one scene's arrays that the bank pads and stacks."""
+    """name -> (shape, item size) of one scene's arrays that the bank pads and stacks, and of the
+    occupancy columns the simulator's world packs from its voxels (:func:`~ignjax.scenes.raygrid.occupied_columns`)."""
     out = {k: (np.shape(v), np.asarray(v).itemsize) for k, v in ray_grid_arrays(grid).items()}
     out["grid"] = (tuple(grid.shape), GRID_TABLE_BYTES)
+    Z, H, W = out["voxcode"][0]
+    out["columns"] = ((H, W, -(-Z // COLUMN_WORD_BITS)), 4)
     return out
 
 

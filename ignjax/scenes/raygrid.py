@@ -64,6 +64,28 @@ class RayGrid:
         return int(self.voxcode.shape[0])
 
 
+COLUMN_WORD_BITS = 32
+"""Voxels per word of :func:`occupied_columns`."""
+
+
+def occupied_columns(grid: RayGrid) -> np.ndarray:
+    """(S, H, W, ceil(Z / 32)) uint32 the ray grid's occupancy packed per
+    column: bit ``k % 32`` of word ``k // 32`` is set when voxel ``k`` of the
+    column is occupied (``voxcode <= 1``, the test of line-of-sight marches)
+    and ``k`` lies below the scene's valid height. One 4-byte look-up then
+    answers a sample that ``voxcode`` answers with a byte of a table eight
+    times larger, which matters where the samples miss the cache (the
+    observation's sight lines). Computed on the host."""
+    vox = np.asarray(grid.voxcode)
+    S, Z, H, W = vox.shape
+    heights = np.asarray(grid.dims)[:, 2]
+    out = np.zeros((S, H, W, -(-Z // COLUMN_WORD_BITS)), np.uint32)
+    for k in range(Z):
+        occ = (vox[:, k] <= 1) & (k < heights)[:, None, None]
+        out[..., k // COLUMN_WORD_BITS] |= occ.astype(np.uint32) << np.uint32(k % COLUMN_WORD_BITS)
+    return out
+
+
 def _floor_row(compiled) -> np.ndarray:
     """(5,) floor rectangle (cx, cy, hx, hy, geom id) of a compiled scene."""
     m, d = compiled.model, compiled.data

@@ -122,7 +122,8 @@ def sight_batch(world: World, states: T.SimState, mask, chunk: int | None = None
         idx, dist = _nearest(world, s_, pose_)
         eye = _eye(cfg, pose_)
         u, limit = jax.vmap(lambda i: sight_lines(world, s_, i, eye))(idx)  # Shape: (K, 2, 3), (K, 2)
-        b1 = jax.vmap(jax.vmap(lambda u_, l_: SR.segment_blocked(rays, s_, eye, u_, l_, l_step, 0, l_first)))(u, limit)
+        b1 = jax.vmap(jax.vmap(lambda u_, l_: SR.segment_blocked(rays, s_, eye, u_, l_, l_step, 0, l_first,
+                                                                 world.columns)))(u, limit)
         return heads, i1, idx, dist, u, limit, b1
 
     default = (jnp.zeros((B, V, R), jnp.float32), jnp.full((B, V, R), f_n, jnp.int32), jnp.zeros((B, K), jnp.int32),
@@ -145,7 +146,7 @@ def sight_batch(world: World, states: T.SimState, mask, chunk: int | None = None
     P = K * SIGHT_POINTS
     eyes = jax.vmap(lambda p: _eye(cfg, p))(pose)
     args = (jnp.repeat(s, P), jnp.repeat(eyes, P, axis=0), u.reshape(-1, 3), limit.reshape(-1))
-    b2 = masked_map(lambda a: SR.segment_blocked(rays, a[0], a[1], a[2], a[3], l_step, l_first, l_n),
+    b2 = masked_map(lambda a: SR.segment_blocked(rays, a[0], a[1], a[2], a[3], l_step, l_first, l_n, world.columns),
                     need.reshape(-1), args, jnp.zeros(B * P, bool), None if chunk is None else chunk * P)
     clear = clear | (need & ~b2.reshape(need.shape))
     valid = jax.vmap(lambda s_, i_: world.bank.instances.valid[s_, i_])(s, idx)

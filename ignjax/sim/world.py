@@ -26,6 +26,7 @@ from ignjax.devices import available_cores
 from ignjax.errors import ConfigError
 from ignjax.scenes.bank import SceneBank
 from ignjax.scenes.fieldtable import FieldTable
+from ignjax.scenes.raygrid import COLUMN_WORD_BITS, occupied_columns
 from ignjax.sim import types as T
 
 
@@ -58,6 +59,13 @@ class World:
             :attr:`fine` from a table a quarter its size (6x faster under
             ``vmap`` on CPU, where those rays miss the cache). Derived when
             not given.
+        columns: (S, H, W, ceil(Z / 32)) uint32 the ray grid's voxel
+            occupancy packed per column
+            (:func:`ignjax.scenes.raygrid.occupied_columns`), which the
+            observation's sight lines read
+            (:func:`ignjax.sim.rays.queries.segment_blocked`): the same
+            answers as the ray grid's ``voxcode`` from a table an eighth its
+            size. Derived when not given.
     """
 
     bank: SceneBank
@@ -65,6 +73,7 @@ class World:
     config: T.SimConfig = T.SimConfig()
     fine: jax.Array | None = None
     packed_obs: jax.Array | None = None
+    columns: jax.Array | None = None
 
     def __post_init__(self):
         if not isinstance(self.fields, FieldTable):
@@ -74,6 +83,8 @@ class World:
         n_col = len(self.config.collision_heights)
         if self.packed_obs is None:
             object.__setattr__(self, "packed_obs", pack_probe_map(self.fine, (1 << n_col, 1 << (n_col + 1))))
+        if self.columns is None:
+            object.__setattr__(self, "columns", on_device(occupied_columns(self.bank.rays)))
 
 
 def world_shapes(bank: SceneBank, field_scenes: Sequence[int], config: T.SimConfig = T.SimConfig()) -> World:
@@ -92,8 +103,9 @@ def world_shapes(bank: SceneBank, field_scenes: Sequence[int], config: T.SimConf
     tables = jax.tree.map(lambda a: jax.ShapeDtypeStruct(a.shape, a.dtype, sharding=a.sharding,
                                                          weak_type=a.aval.weak_type), bank)
     fields = FieldTable.shapes([bank.navgrids[int(s)].shape for s in field_scenes], (H, W), ref.sharding)
+    _, Z, RH, RW = bank.rays.voxcode.shape
     return World(tables, fields, config, fine=like((S, FINE * H, FINE * W), np.uint8),
-                 packed_obs=like((S, H, W), np.uint32))
+                 packed_obs=like((S, H, W), np.uint32), columns=like((S, RH, RW, -(-Z // COLUMN_WORD_BITS)), np.uint32))
 
 
 LOW_OBS_HEIGHT = 0.45
