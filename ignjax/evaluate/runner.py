@@ -103,10 +103,10 @@ def agent_batches(es: EpisodeSet, agent: Agent | str, *, params=None, batch: int
         yield i, out, traj
 
 
-WORLD_BYTES_PER_CELL = FINE * FINE + 4
+WORLD_BYTES_PER_CELL = FINE * FINE + 4 + 4
 """Bytes the simulator's world adds per navigation cell of a scene: its probe
-map (:data:`~ignjax.sim.world.FINE` ^ 2 fine cells of one byte) and the
-packed observation heights (4 bytes)."""
+map (:data:`~ignjax.sim.world.FINE` ^ 2 fine cells of one byte), the packed
+observation heights and the packed collision heights (4 bytes each)."""
 BANK_MB = 1024
 """Default budget of one bucket of scenes (``--bank-mb``)."""
 

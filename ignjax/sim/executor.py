@@ -20,7 +20,7 @@ from ignjax.sim import types as T
 from ignjax.sim.compact import chunk_size, masked_map
 from ignjax.sim.queries import geodesic_to_target, navigable_at, sector_of
 from ignjax.sim.rays import queries as SR
-from ignjax.sim.world import FINE, World, fine_at, probe_free
+from ignjax.sim.world import FINE, World, packed_at, probe_free
 
 
 DEPTH_ELEVATION = math.radians(55.0)  # steepest pixel ray followed to the full waypoint range
@@ -185,12 +185,11 @@ def _probe(world: World, s, xy, h, length):
     spacing = res / FINE  # one sample per fine cell: nothing thicker than a fine cell is skipped
     n_samples = int(math.ceil((cfg.collision_distance + res) / spacing))
     t = jnp.arange(1, n_samples + 1, dtype=jnp.float32) * spacing  # Shape: (n,)
-    col_mask = (1 << len(cfg.collision_heights)) - 1
     n_nav = min(int(math.ceil(cfg.micro_step / spacing)), n_samples)  # samples a micro-step can reach
     t_nav = t[:n_nav]
     u = jnp.stack([jnp.cos(h), jnp.sin(h)])
     pts = xy[None] + t[:, None] * u[None]
-    hit = (fine_at(world, s, pts) & col_mask) != 0
+    hit = packed_at(world, world.packed_col, 1, s, pts) != 0  # any collision height (World.packed_col)
     free = jnp.where(jnp.any(hit), t[jnp.argmax(hit)] - spacing, jnp.float32(cfg.collision_distance + res))
     nav = navigable_at(world, s, jnp.concatenate([pts[:n_nav], (xy + length * u)[None], (xy + 0.5 * length * u)[None]]))
     along = nav[:n_nav]

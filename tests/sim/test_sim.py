@@ -129,8 +129,8 @@ def test_probe_map_is_computed_once_per_bank_and_settings(small_world):
 
 
 def test_packed_observation_map_equals_probe_map(small_world):
-    """The observation's packed probe map answers exactly as the fine probe map,
-    inside the grid, on its edges and outside it."""
+    """The observation's and the probes' packed probe maps answer exactly as the
+    fine probe map, inside the grid, on its edges and outside it."""
     w = small_world
     g = w.bank.grid
     n_col = len(w.config.collision_heights)
@@ -144,6 +144,9 @@ def test_packed_observation_map_equals_probe_map(small_world):
         packed = np.asarray(W.packed_at(w, w.packed_obs, 2, jnp.int32(s), xy))
         assert np.array_equal((fine >> n_col) & 3, packed)
         assert ((fine >> n_col) & 3).any()  # the check saw occupied cells
+        collision = np.asarray(W.packed_at(w, w.packed_col, 1, jnp.int32(s), xy))
+        assert np.array_equal((fine & ((1 << n_col) - 1)) != 0, collision != 0)
+        assert collision.any() and not collision.all()
 
 
 @pytest.mark.parametrize("rng_m,min_agree", [(None, 0.995), (2.0, 0.98)], ids=["controller-range", "2m"])
