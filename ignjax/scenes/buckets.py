@@ -29,7 +29,7 @@ import numpy as np
 from ignjax.errors import ConfigError
 from ignjax.scenes.fieldtable import padded_cells
 from ignjax.scenes.navgrid import NavGrid
-from ignjax.scenes.raygrid import COLUMN_WORD_BITS, ray_grid_arrays
+from ignjax.scenes.raygrid import column_words, ray_grid_arrays
 
 GRID_TABLE_BYTES = 9
 """Bytes a navigation cell takes in the bank's grid table: navigable (1), room (4), component (4)."""
@@ -41,7 +41,7 @@ def _table_shapes(grid: NavGrid) -> dict[str, tuple[tuple[int, ...], int]]:
     out = {k: (np.shape(v), np.asarray(v).itemsize) for k, v in ray_grid_arrays(grid).items()}
     out["grid"] = (tuple(grid.shape), GRID_TABLE_BYTES)
     Z, H, W = out["voxcode"][0]
-    out["columns"] = ((H, W, -(-Z // COLUMN_WORD_BITS)), 4)
+    out["columns"] = ((H, W, column_words(Z)), 4)
     return out
 
 

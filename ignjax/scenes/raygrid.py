@@ -68,6 +68,11 @@ COLUMN_WORD_BITS = 32
 """Voxels per word of :func:`occupied_columns`."""
 
 
+def column_words(n_slices: int) -> int:
+    """Words of :func:`occupied_columns` per column of ``n_slices`` voxels."""
+    return -(-int(n_slices) // COLUMN_WORD_BITS)
+
+
 def occupied_columns(grid: RayGrid) -> np.ndarray:
     """(S, H, W, ceil(Z / 32)) uint32 the ray grid's occupancy packed per
     column: bit ``k % 32`` of word ``k // 32`` is set when voxel ``k`` of the
@@ -79,7 +84,7 @@ def occupied_columns(grid: RayGrid) -> np.ndarray:
     vox = np.asarray(grid.voxcode)
     S, Z, H, W = vox.shape
     heights = np.asarray(grid.dims)[:, 2]
-    out = np.zeros((S, H, W, -(-Z // COLUMN_WORD_BITS)), np.uint32)
+    out = np.zeros((S, H, W, column_words(Z)), np.uint32)
     for k in range(Z):
         occ = (vox[:, k] <= 1) & (k < heights)[:, None, None]
         out[..., k // COLUMN_WORD_BITS] |= occ.astype(np.uint32) << np.uint32(k % COLUMN_WORD_BITS)

@@ -105,5 +105,6 @@ def instance_in_sight(world: World, s, i, eye):
     (its centre or top centre) before the ray enters the box."""
     step, n = sight_samples(world)
     u, limit = sight_lines(world, s, i, eye)
-    blocked = jax.vmap(lambda u_, l_: SR.segment_blocked(world.bank.rays, s, eye, u_, l_, step, 0, n, world.columns))(u, limit)
+    blocked = jax.vmap(lambda u_, l_: SR.segment_blocked(world.bank.rays, s, eye, u_, l_, step, 0, n,
+                                                         world.columns))(u, limit)
     return jnp.any(~blocked) & world.bank.instances.valid[s, i]

@@ -26,7 +26,7 @@ from ignjax.devices import available_cores
 from ignjax.errors import ConfigError
 from ignjax.scenes.bank import SceneBank
 from ignjax.scenes.fieldtable import FieldTable
-from ignjax.scenes.raygrid import COLUMN_WORD_BITS, occupied_columns
+from ignjax.scenes.raygrid import column_words, occupied_columns
 from ignjax.sim import types as T
 
 
@@ -114,7 +114,8 @@ def world_shapes(bank: SceneBank, field_scenes: Sequence[int], config: T.SimConf
     fields = FieldTable.shapes([bank.navgrids[int(s)].shape for s in field_scenes], (H, W), ref.sharding)
     _, Z, RH, RW = bank.rays.voxcode.shape
     return World(tables, fields, config, fine=like((S, FINE * H, FINE * W), np.uint8),
-                 packed_obs=like((S, H, W), np.uint32), packed_col=like((S, H, W), np.uint32), columns=like((S, RH, RW, -(-Z // COLUMN_WORD_BITS)), np.uint32))
+                 packed_obs=like((S, H, W), np.uint32), packed_col=like((S, H, W), np.uint32),
+                 columns=like((S, RH, RW, column_words(Z)), np.uint32))
 
 
 LOW_OBS_HEIGHT = 0.45
